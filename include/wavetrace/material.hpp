@@ -1,0 +1,126 @@
+// The materials: how a hit scatters the path and what it emits.
+#pragma once
+
+#include "wavetrace/optics.hpp"
+#include "wavetrace/ray.hpp"
+#include "wavetrace/sampling.hpp"
+#include "wavetrace/texture.hpp"
+
+namespace wt {
+
+enum class MaterialKind : uint32_t { Lambertian = 0, Metal = 1, Dielectric = 2, Coated = 3, Emissive = 4 };
+constexpr uint32_t kMaterialKindCount = 5;
+
+struct Material {
+  MaterialKind kind;
+  int32_t texture;  // < 0: the constant albedo
+  float fuzz;       // Metal
+  float ior;        // Dielectric, Coated (the coat)
+  vec3 albedo;      // Lambertian, Metal, Coated (the base); Dielectric: transmission tint
+  vec3 emission;    // Emissive
+  // Shading work differs by material kind and by texture kind; this key groups hits
+  // that run the same code, so that sorting by it gives warps one code path.
+  uint32_t sort_key;
+};
+
+// Sort keys: kind * 4 + texture slot (0 untextured, 1 + TextureKind).
+WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /* -1: none */) {
+  return static_cast<uint32_t>(kind) * 4u + static_cast<uint32_t>(texture_kind + 1);
+}
+constexpr uint32_t kSortKeyCount = kMaterialKindCount * 4;
+constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene sort last
+
+// Secondary rays leave the surface this far along the normal, on the side they go to.
+constexpr float kSurfaceOffset = 1e-3f;
+
+WT_HD WT_INLINE Ray spawn_ray(const vec3& p, const vec3& outward_n, const vec3& dir) {
+  float side = glm::dot(dir, outward_n) >= 0.0f ? 1.0f : -1.0f;
+  return Ray{p + (side * kSurfaceOffset) * outward_n, dir};
+}
+
+// Everything a material needs to know about the hit.
+struct SurfacePoint {
+  vec3 p;          // world position
+  vec3 n;          // unit outward normal
+  vec3 local;      // position relative to the sphere's centre
+  bool front;      // the ray arrived from outside
+};
+
+WT_HD WT_INLINE vec3 material_albedo(const Material& m, const Texture* textures, const ImageView* images,
+                                     const SurfacePoint& sp) {
+  return m.texture < 0 ? m.albedo : m.albedo * eval_texture(textures[m.texture], images, sp.local, sp.n);
+}
+
+WT_HD WT_INLINE void scatter_lambertian(const vec3& albedo, const SurfacePoint& sp, const vec3& facing_n,
+                                        const Rng& rng, vec3& attenuation, Ray& next) {
+  vec3 d = cosine_direction(facing_n, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB));
+  attenuation = albedo;
+  next = spawn_ray(sp.p, sp.n, d);
+}
+
+// Mirror reflection perturbed by fuzz; absorbed when the perturbation sends it
+// below the surface.
+WT_HD WT_INLINE bool scatter_metal(const Material& m, const vec3& albedo, const Ray& in, const SurfacePoint& sp,
+                                   const vec3& facing_n, const Rng& rng, vec3& attenuation, Ray& next) {
+  vec3 d = reflect(in.dir, facing_n);
+  if (m.fuzz > 0.0f) {
+    d = d + m.fuzz * unit_sphere_point(rng.uniform(kDimFuzzA), rng.uniform(kDimFuzzB));
+    float len2 = glm::dot(d, d);
+    if (len2 < 1e-12f || glm::dot(d, facing_n) <= 0.0f) return false;
+    d *= 1.0f / sqrtf(len2);
+  }
+  attenuation = albedo;
+  next = spawn_ray(sp.p, sp.n, d);
+  return true;
+}
+
+// Reflect with Schlick's probability (always under total internal reflection), else refract.
+WT_HD WT_INLINE void scatter_dielectric(const Material& m, const vec3& albedo, const Ray& in,
+                                        const SurfacePoint& sp, const vec3& facing_n, const Rng& rng,
+                                        vec3& attenuation, Ray& next) {
+  float eta = sp.front ? 1.0f / m.ior : m.ior;
+  float cos_i = fminf(-glm::dot(in.dir, facing_n), 1.0f);
+  vec3 d;
+  if (!refract(in.dir, facing_n, eta, d) || rng.uniform(kDimLayer) < schlick(cos_i, eta)) {
+    d = reflect(in.dir, facing_n);
+  }
+  attenuation = albedo;
+  next = spawn_ray(sp.p, sp.n, glm::normalize(d));
+}
+
+// A clear dielectric coat over a Lambertian base: the coat reflects with Schlick's
+// probability; otherwise light reaches the base and leaves diffusely.
+WT_HD WT_INLINE void scatter_coated(const Material& m, const vec3& albedo, const Ray& in, const SurfacePoint& sp,
+                                    const vec3& facing_n, const Rng& rng, vec3& attenuation, Ray& next) {
+  float cos_i = fminf(-glm::dot(in.dir, facing_n), 1.0f);
+  if (sp.front && rng.uniform(kDimLayer) < schlick(cos_i, 1.0f / m.ior)) {
+    attenuation = vec3(1.0f);
+    next = spawn_ray(sp.p, sp.n, reflect(in.dir, facing_n));
+    return;
+  }
+  scatter_lambertian(albedo, sp, facing_n, rng, attenuation, next);
+}
+
+// Scatters the path at a hit. Returns false when the path ends there (absorbed or emitter).
+WT_HD WT_INLINE bool scatter(const Material& m, const Texture* textures, const ImageView* images, const Ray& in,
+                             const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
+  vec3 facing_n = sp.front ? sp.n : -sp.n;
+  switch (m.kind) {
+    case MaterialKind::Lambertian:
+      scatter_lambertian(material_albedo(m, textures, images, sp), sp, facing_n, rng, attenuation, next);
+      return true;
+    case MaterialKind::Metal:
+      return scatter_metal(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+    case MaterialKind::Dielectric:
+      scatter_dielectric(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+      return true;
+    case MaterialKind::Coated:
+      scatter_coated(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+      return true;
+    case MaterialKind::Emissive:
+      return false;
+  }
+  return false;
+}
+
+}  // namespace wt

@@ -1,0 +1,77 @@
+// One bounce of a path, and a whole path: the single definition of the light
+// transport that every backend and kernel runs.
+#pragma once
+
+#include "wavetrace/scene_view.hpp"
+
+namespace wt {
+
+// Rays start this far along themselves at the earliest (beyond the surface offset
+// this only guards against degenerate self-hits).
+constexpr float kRayTMin = 1e-4f;
+constexpr float kRayTMax = 3.0e38f;
+
+template <class Scene>
+WT_HD WT_INLINE Hit intersect_scene(const Scene& scene, const Ray& ray) {
+  return intersect_closest(scene, ray, kRayTMin, kRayTMax);
+}
+
+// Camera ray of path (pixel, sample).
+template <class Scene>
+WT_HD WT_INLINE Ray primary_ray(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample) {
+  Rng rng = Rng::at(rp.seed, pixel, sample, 0);
+  int x = static_cast<int>(pixel % static_cast<uint32_t>(rp.width));
+  int y = static_cast<int>(pixel / static_cast<uint32_t>(rp.width));
+  return scene.camera.generate(x, y, rp.width, rp.height, rng);
+}
+
+// Shades a hit at `bounce`: adds what the surface emits, scatters, and plays
+// Russian roulette. On true the path goes on along `ray`, with `throughput` updated.
+template <class Scene>
+WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const Hit& hit, uint32_t pixel,
+                               uint32_t sample, uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance) {
+  SphereGeom s = scene.sphere(hit.sphere);
+  const Material& m = scene.material_of(hit.sphere);
+  SurfacePoint sp;
+  sp.p = ray.at(hit.t);
+  sp.local = sp.p - vec3(s.x, s.y, s.z);
+  sp.n = sp.local * (1.0f / s.w);
+  sp.front = glm::dot(ray.dir, sp.n) < 0.0f;
+  if (m.kind == MaterialKind::Emissive) {
+    radiance += throughput * m.emission;
+    return false;
+  }
+  Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
+  vec3 attenuation;
+  Ray next;
+  if (!scatter(m, scene.texture_array(), scene.image_array(), ray, sp, rng, attenuation, next)) return false;
+  throughput *= attenuation;
+  if (static_cast<int>(bounce) + 1 >= rp.roulette_depth) {
+    // Survive with probability p and divide by it: the expectation is unchanged.
+    float p = fminf(fmaxf(throughput.x, fmaxf(throughput.y, throughput.z)), 0.95f);
+    if (!(rng.uniform(kDimRoulette) < p)) return false;
+    throughput *= 1.0f / p;
+  }
+  ray = next;
+  return true;
+}
+
+// The radiance of path (pixel, sample); `rays` grows by every ray intersected.
+template <class Scene>
+WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample,
+                                uint32_t& rays) {
+  Ray ray = primary_ray(scene, rp, pixel, sample);
+  vec3 throughput(1.0f), radiance(0.0f);
+  for (int bounce = 0; bounce < rp.depth; ++bounce) {
+    Hit hit = intersect_scene(scene, ray);
+    ++rays;
+    if (hit.sphere < 0) {
+      radiance += throughput * scene.sky.radiance(ray.dir);
+      break;
+    }
+    if (!shade_hit(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance)) break;
+  }
+  return radiance;
+}
+
+}  // namespace wt

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs the Debian packages wavetrace builds against. Safe to run again:
+# packages already present are left alone and nothing is fetched.
+set -euo pipefail
+packages=(cmake ninja-build g++ libglm-dev nlohmann-json3-dev libstb-dev libcli11-dev libgtest-dev)
+if [[ "${WAVETRACE_WITH_PLOTS:-0}" == 1 ]]; then
+  packages+=(python3-matplotlib)
+fi
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo_cmd=""
+  [[ $(id -u) -ne 0 ]] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

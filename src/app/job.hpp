@@ -1,0 +1,48 @@
+// One render job: a scene, its settings, where the image and the stats go.
+// `render` runs one; `batch` runs many and goes on past a failing one.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "image/image_io.hpp"
+#include "render/renderer.hpp"
+
+namespace wt::app {
+
+struct Job {
+  std::string scene;
+  std::string output;
+  std::string stats;  // empty: no stats file
+  std::optional<int> width, height, spp, depth, roulette_depth;
+  std::optional<uint32_t> seed;
+  std::string backend = "auto";
+  std::string kernel = "megakernel";
+  int warmup = 0;
+  int64_t wave_size = 0;
+  int threads = 0;
+  Encoding encoding = Encoding::Srgb;
+  bool progress = true;
+  bool profile = false;
+};
+
+// Exit codes: bad input (scene, settings, paths) and failures of the machine.
+constexpr int kExitBadInput = 2;
+constexpr int kExitFailure = 1;
+
+struct JobOutcome {
+  int exit_code = 0;
+  std::string message;  // the one line that says why, when exit_code != 0
+  RenderParams params{};
+  std::string backend, kernel;
+  RenderResult result;
+};
+
+// Runs a job; never throws. Writes the image (and stats) only when the render succeeded.
+JobOutcome run_job(const Job& job);
+
+Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
+Kernel parse_kernel(const std::string& name);    // throws SceneError
+
+}  // namespace wt::app

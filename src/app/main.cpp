@@ -1,0 +1,106 @@
+// The wavetrace command: render one scene, or a batch of jobs.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+
+#include "app/batch.hpp"
+#include "app/job.hpp"
+
+namespace {
+
+using wt::app::Job;
+
+// The options that render and batch share; they fill `job`.
+void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
+  cmd.add_option("--width", job.width, "image width in pixels")->check(CLI::Range(1, 16384));
+  cmd.add_option("--height", job.height, "image height in pixels")->check(CLI::Range(1, 16384));
+  cmd.add_option("--spp", job.spp, "samples per pixel")->check(CLI::Range(1, 1000000));
+  cmd.add_option("--depth", job.depth, "most rays per path")->check(CLI::Range(1, 1024));
+  cmd.add_option("--roulette-depth", job.roulette_depth, "Russian roulette from this many bounces on")
+      ->check(CLI::Range(0, 1 << 30));
+  cmd.add_option("--seed", job.seed, "render seed");
+  cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
+      ->check(CLI::IsMember({"cuda", "cpu", "auto"}));
+  cmd.add_option("--kernel", job.kernel, "megakernel, megakernel-constant, wavefront or wavefront-unsorted")
+      ->check(CLI::IsMember({"megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"}));
+  cmd.add_option("--warmup", job.warmup, "untimed renders before the timed one")->check(CLI::Range(0, 100));
+  cmd.add_option("--wave-size", job.wave_size, "wavefront path slots (default: chosen from free memory)")
+      ->check(CLI::Range(int64_t(1024), int64_t(1) << 27));
+  cmd.add_option("--threads", job.threads, "CPU threads (default: all cores)")->check(CLI::Range(1, 1024));
+  cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
+      ->check(CLI::IsMember({"srgb", "gamma2"}));
+  cmd.add_flag("--profile", job.profile, "print the wavefront's per-stage times");
+}
+
+void set_encoding(Job& job, const std::string& encoding) {
+  job.encoding = encoding == "gamma2" ? wt::Encoding::Gamma2 : wt::Encoding::Srgb;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"wavetrace: a wavefront path tracer, with the megakernel kept for comparison"};
+  app.require_subcommand(1);
+
+  Job job;
+  std::string encoding = "srgb";
+  bool quiet = false;
+  CLI::App* render = app.add_subcommand("render", "render one scene");
+  render->add_option("scene", job.scene, "scene file (JSON)")->required();
+  render->add_option("-o,--output", job.output, "image file: .png (8-bit) or .pfm (linear float)")->required();
+  render->add_option("--stats", job.stats, "write render statistics as JSON");
+  render->add_flag("-q,--quiet", quiet, "no progress line");
+  add_render_options(*render, job, encoding);
+
+  Job batch_job;
+  std::string batch_encoding = "srgb";
+  std::vector<std::string> inputs;
+  std::string output_dir = ".";
+  CLI::App* batch = app.add_subcommand("batch", "render a jobs file, or several scene files");
+  batch->add_option("inputs", inputs, "a jobs file ({\"jobs\": [...]}) or scene files")->required();
+  batch->add_option("--output-dir", output_dir, "where scene files given directly are rendered to");
+  add_render_options(*batch, batch_job, batch_encoding);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    return wt::app::kExitBadInput;
+  }
+
+  if (*render) {
+    set_encoding(job, encoding);
+    job.progress = !quiet;
+    wt::app::JobOutcome o = wt::app::run_job(job);
+    if (o.exit_code != 0) {
+      std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
+      return o.exit_code;
+    }
+    const wt::RenderResult& r = o.result;
+    std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
+                 o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
+                 static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);
+    return 0;
+  }
+
+  set_encoding(batch_job, batch_encoding);
+  std::vector<wt::app::PlannedJob> jobs;
+  try {
+    // One input that is a jobs file; otherwise every input is a scene file.
+    if (inputs.size() == 1 && wt::app::is_jobs_file(inputs[0])) {
+      jobs = wt::app::read_jobs_file(inputs[0], batch_job);
+    } else {
+      for (const std::string& scene : inputs) {
+        Job j = batch_job;
+        j.scene = scene;
+        j.output = (std::filesystem::path(output_dir) / std::filesystem::path(scene).stem()).string() + ".png";
+        jobs.push_back({j, ""});
+      }
+    }
+  } catch (const wt::SceneError& e) {
+    std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    return wt::app::kExitBadInput;
+  }
+  return wt::app::run_batch(jobs);
+}

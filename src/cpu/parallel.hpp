@@ -1,0 +1,40 @@
+// Runs fn(begin, end) over [0, n) in chunks on a set of host threads, chunks
+// handed out dynamically so that uneven work (long paths) balances.
+#pragma once
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace wt::cpu {
+
+inline int thread_count(int requested) {
+  if (requested > 0) return requested;
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+template <class Fn>
+void parallel_for(int64_t n, int64_t chunk, int threads, Fn&& fn) {
+  std::atomic<int64_t> next{0};
+  auto worker = [&](int tid) {
+    for (;;) {
+      int64_t begin = next.fetch_add(chunk);
+      if (begin >= n) return;
+      fn(begin, std::min(n, begin + chunk), tid);
+    }
+  };
+  int t = static_cast<int>(std::min<int64_t>(threads, (n + chunk - 1) / chunk));
+  if (t <= 1) {
+    worker(0);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(t - 1);
+  for (int i = 1; i < t; ++i) pool.emplace_back(worker, i);
+  worker(0);
+  for (auto& th : pool) th.join();
+}
+
+}  // namespace wt::cpu

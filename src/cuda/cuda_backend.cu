@@ -1,0 +1,114 @@
+// The CUDA backend: uploads the scene, checks that the render fits the device,
+// runs the chosen kernel with CUDA-event timing and reads the film back.
+#include "cuda/cuda_backend.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "cuda/buffer.hpp"
+#include "cuda/device_scene.hpp"
+#include "cuda/event.hpp"
+#include "megakernel/megakernel.hpp"
+#include "stages/wavefront.hpp"
+
+namespace wt::cuda {
+
+namespace {
+
+constexpr const char* kStage = "render";
+
+std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB"; }
+
+// The megakernel renders in a few passes of samples so that progress can be shown
+// between them; the next pass is queued before the host waits on the last one.
+RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options) {
+  const RenderParams& rp = options.params;
+  const bool constant = options.kernel == Kernel::MegakernelConstant;
+  if (constant) upload_constant_scene(scene, ds.view());
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  DeviceBuffer<float> film(pixels * 3, kStage);
+  DeviceBuffer<unsigned long long> rays(1, kStage);
+  const int passes = std::min(rp.spp, 10);
+
+  auto run = [&](bool report) {
+    film.zero(kStage);
+    rays.zero(kStage);
+    EventTimer timer("megakernel");
+    timer.start();
+    std::vector<Event> pass_done(passes);
+    int first = 0;
+    for (int p = 0; p < passes; ++p) {
+      int samples = rp.spp / passes + (p < rp.spp % passes ? 1 : 0);
+      if (constant) {
+        launch_megakernel_constant(rp, first, samples, film.get(), rays.get(), nullptr);
+      } else {
+        launch_megakernel(ds.view(), rp, first, samples, film.get(), rays.get(), nullptr);
+      }
+      pass_done[p].record("megakernel");
+      first += samples;
+      if (report && p > 0) {
+        pass_done[p - 1].synchronize("megakernel");
+        unsigned long long so_far = 0;
+        WT_CUDA(cudaMemcpy(&so_far, rays.get(), sizeof(so_far), cudaMemcpyDeviceToHost), "megakernel");
+        options.progress(static_cast<double>(p) / passes, so_far, timer.elapsed_host());
+      }
+    }
+    return timer.stop();
+  };
+  for (int i = 0; i < options.warmup; ++i) run(false);
+  RenderResult out;
+  out.seconds = run(static_cast<bool>(options.progress));
+  unsigned long long counted = 0;
+  WT_CUDA(cudaMemcpy(&counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
+  out.rays = counted;
+  out.rgb = film.download(kStage);
+  const float inv = 1.0f / static_cast<float>(rp.spp);
+  for (float& v : out.rgb) v *= inv;
+  return out;
+}
+
+}  // namespace
+
+size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size) {
+  size_t film = static_cast<size_t>(rp.width) * rp.height * 3 * sizeof(float);
+  if (kernel == Kernel::Wavefront || kernel == Kernel::WavefrontUnsorted) {
+    return film + wavefront_bytes(wave_size);
+  }
+  return film;
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+  if (device_count() == 0) throw SceneError("backend: cuda was asked for, but no CUDA device is present");
+  const RenderParams& rp = options.params;
+  DeviceInfo info = device_info();
+
+  const bool wavefront = options.kernel == Kernel::Wavefront || options.kernel == Kernel::WavefrontUnsorted;
+  int64_t wave = wavefront ? choose_wave_size(options.wave_size, rp, info.free_memory) : 0;
+  // Checked before allocating anything: a render that cannot fit fails with a
+  // message rather than with an allocation error halfway through.
+  size_t scene_bytes = 0;
+  for (const Image& im : scene.images) scene_bytes += im.texels.size() * sizeof(float);
+  scene_bytes += scene.spheres.size() * (sizeof(SphereGeom) + sizeof(uint32_t)) + scene.nodes.size() * sizeof(BvhNode);
+  size_t need = render_state_bytes(rp, options.kernel, wave) + scene_bytes;
+  size_t usable = info.free_memory - std::min(info.free_memory, size_t(256) << 20);  // headroom for the runtime
+  if (need > usable) {
+    throw SceneError("width x height: " + std::to_string(rp.width) + " x " + std::to_string(rp.height) +
+                     " with this kernel needs " + mib(need) + " of device memory; " + info.name + " has " +
+                     mib(info.free_memory) + " free");
+  }
+
+  auto t0 = std::chrono::steady_clock::now();
+  DeviceScene ds(scene, rp.width, rp.height);
+  WT_CUDA(cudaDeviceSynchronize(), "scene upload");
+  double upload = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  RenderResult out = wavefront ? render_wavefront(ds.view(), scene.sort_key_bits(), options, wave) : render_megakernel(scene, ds, options);
+  out.upload_seconds = upload;
+  out.paths = static_cast<uint64_t>(rp.width) * rp.height * rp.spp;
+  out.device = info.name;
+  if (options.progress) options.progress(1.0, out.rays, out.seconds);
+  return out;
+}
+
+}  // namespace wt::cuda

@@ -1,0 +1,38 @@
+// The CUDA device as the rest of the program sees it, and the error check that
+// every CUDA call and launch goes through.
+#pragma once
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+namespace wt::cuda {
+
+struct CudaError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Number of usable CUDA devices; 0 where there is no driver or no device.
+int device_count();
+
+struct DeviceInfo {
+  std::string name;
+  int sm_count = 0;
+  int sm_clock_khz = 0;
+  int memory_clock_khz = 0;
+  int driver_version = 0;
+  int runtime_version = 0;
+  size_t total_memory = 0;
+  size_t free_memory = 0;
+};
+
+DeviceInfo device_info();
+
+// Throws CudaError "<stage>: <call> failed: <error>" when code is not cudaSuccess.
+void check(int code, const char* call, const char* stage);
+
+}  // namespace wt::cuda
+
+#define WT_CUDA(call, stage) ::wt::cuda::check(static_cast<int>(call), #call, stage)
+// After a kernel launch: launch-configuration errors now, execution errors at the next sync.
+#define WT_CUDA_LAUNCHED(kernel, stage) ::wt::cuda::check(static_cast<int>(cudaGetLastError()), kernel " launch", stage)

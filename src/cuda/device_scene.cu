@@ -1,0 +1,63 @@
+#include "cuda/device_scene.hpp"
+
+namespace wt::cuda {
+
+namespace {
+constexpr const char* kStage = "scene upload";
+}
+
+DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
+  spheres_.upload(scene.spheres, kStage);
+  sphere_material_.upload(scene.sphere_material, kStage);
+  nodes_.upload(scene.nodes, kStage);
+  materials_.upload(scene.materials, kStage);
+  textures_.upload(scene.textures, kStage);
+  bytes_ = scene.spheres.size() * sizeof(SphereGeom) + scene.sphere_material.size() * sizeof(uint32_t) +
+           scene.nodes.size() * sizeof(BvhNode) + scene.materials.size() * sizeof(Material) +
+           scene.textures.size() * sizeof(Texture);
+
+  // Texels are fetched one by one (point sampling) and filtered by the shared
+  // bilinear code, so the GPU computes exactly what the CPU computes.
+  for (const Image& im : scene.images) {
+    cudaChannelFormatDesc desc = cudaCreateChannelDesc<float4>();
+    cudaArray_t array = nullptr;
+    WT_CUDA(cudaMallocArray(&array, &desc, im.width, im.height), kStage);
+    arrays_.push_back(array);
+    const size_t row = static_cast<size_t>(im.width) * 4 * sizeof(float);
+    WT_CUDA(cudaMemcpy2DToArray(array, 0, 0, im.texels.data(), row, row, im.height, cudaMemcpyHostToDevice), kStage);
+    bytes_ += row * im.height;
+
+    cudaResourceDesc res{};
+    res.resType = cudaResourceTypeArray;
+    res.res.array.array = array;
+    cudaTextureDesc tex{};
+    tex.addressMode[0] = cudaAddressModeClamp;
+    tex.addressMode[1] = cudaAddressModeClamp;
+    tex.filterMode = cudaFilterModePoint;
+    tex.readMode = cudaReadModeElementType;
+    tex.normalizedCoords = 0;
+    cudaTextureObject_t object = 0;
+    WT_CUDA(cudaCreateTextureObject(&object, &res, &tex, nullptr), kStage);
+    objects_.push_back(object);
+    image_views_.push_back(ImageView{object, nullptr, im.width, im.height});
+  }
+  images_.upload(image_views_, kStage);
+
+  view_.spheres = spheres_.get();
+  view_.sphere_material = sphere_material_.get();
+  view_.nodes = nodes_.get();
+  view_.materials = materials_.get();
+  view_.textures = textures_.get();
+  view_.images = images_.get();
+  view_.sphere_count = static_cast<int32_t>(scene.spheres.size());
+  view_.node_total = static_cast<int32_t>(scene.nodes.size());
+  view_.sky = scene.sky;
+  view_.camera = Camera::make(scene.camera, width, height);
+}
+
+DeviceScene::~DeviceScene() {
+  for (cudaTextureObject_t o : objects_) cudaDestroyTextureObject(o);
+  for (cudaArray_t a : arrays_) cudaFreeArray(a);
+}
+
+}  // namespace wt::cuda

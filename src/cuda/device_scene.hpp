@@ -1,0 +1,38 @@
+// A scene uploaded to the GPU: its arrays in global memory and its images as
+// CUDA texture objects.
+#pragma once
+
+#include <vector>
+
+#include "cuda/buffer.hpp"
+#include "scene/scene.hpp"
+
+namespace wt::cuda {
+
+class DeviceScene {
+ public:
+  DeviceScene(const Scene& scene, int width, int height);
+  ~DeviceScene();
+  DeviceScene(const DeviceScene&) = delete;
+  DeviceScene& operator=(const DeviceScene&) = delete;
+
+  const SceneView& view() const { return view_; }
+  // The host copies of the image views (texture objects filled in), for constant memory.
+  const std::vector<ImageView>& image_views() const { return image_views_; }
+  size_t bytes() const { return bytes_; }
+
+ private:
+  DeviceBuffer<SphereGeom> spheres_;
+  DeviceBuffer<uint32_t> sphere_material_;
+  DeviceBuffer<BvhNode> nodes_;
+  DeviceBuffer<Material> materials_;
+  DeviceBuffer<Texture> textures_;
+  DeviceBuffer<ImageView> images_;
+  std::vector<cudaArray_t> arrays_;
+  std::vector<cudaTextureObject_t> objects_;
+  std::vector<ImageView> image_views_;
+  SceneView view_{};
+  size_t bytes_ = 0;
+};
+
+}  // namespace wt::cuda

@@ -1,0 +1,25 @@
+// The one-kernel renderers kept for comparison: one thread per pixel traces every
+// bounce of every sample in one launch, over a scene in global or constant memory.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include "scene/scene.hpp"
+
+namespace wt::cuda {
+
+// Adds samples [first_sample, first_sample + samples) of every pixel to film (RGB
+// sums) and the rays they intersect to *rays.
+void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
+                       unsigned long long* rays, cudaStream_t stream);
+
+// Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
+size_t constant_scene_capacity();
+
+// Copies the scene into __constant__ memory; throws SceneError if it does not fit.
+void upload_constant_scene(const Scene& scene, const SceneView& device_view);
+
+void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
+                                unsigned long long* rays, cudaStream_t stream);
+
+}  // namespace wt::cuda

@@ -1,0 +1,39 @@
+// The megakernel's per-thread body, shared by the global- and constant-memory
+// variants: they differ only in the scene accessor.
+#pragma once
+
+#include "wavetrace/path.hpp"
+
+namespace wt::cuda {
+
+constexpr int kMegakernelBlockX = 16;
+constexpr int kMegakernelBlockY = 8;
+
+template <class Scene>
+__device__ __forceinline__ void megakernel_pixel(const Scene& scene, const RenderParams& rp, int first_sample,
+                                                 int samples, float* film, unsigned long long* rays) {
+  const int x = blockIdx.x * blockDim.x + threadIdx.x;
+  const int y = blockIdx.y * blockDim.y + threadIdx.y;
+  uint32_t count = 0;
+  if (x < rp.width && y < rp.height) {
+    const uint32_t pixel = static_cast<uint32_t>(y) * rp.width + x;
+    vec3 sum(0.0f);
+    for (int s = first_sample; s < first_sample + samples; ++s) {
+      sum += trace_path(scene, rp, pixel, static_cast<uint32_t>(s), count);
+    }
+    float* f = film + 3 * static_cast<size_t>(pixel);
+    f[0] += sum.x;
+    f[1] += sum.y;
+    f[2] += sum.z;
+  }
+  // One atomic per warp, not per ray: every lane reaches this point.
+  const uint32_t warp_total = __reduce_add_sync(0xffffffffu, count);
+  if ((threadIdx.x + threadIdx.y * blockDim.x) % 32 == 0 && warp_total) atomicAdd(rays, warp_total);
+}
+
+inline dim3 megakernel_grid(const RenderParams& rp) {
+  return dim3((rp.width + kMegakernelBlockX - 1) / kMegakernelBlockX,
+              (rp.height + kMegakernelBlockY - 1) / kMegakernelBlockY);
+}
+
+}  // namespace wt::cuda

@@ -1,0 +1,98 @@
+// The megakernel over a scene in __constant__ memory. Constant memory broadcasts
+// a value when a warp's threads read the same address and serialises otherwise,
+// so this variant shows what divergent scene access costs.
+#include <cstring>
+#include <string>
+
+#include "cuda/device.hpp"
+#include "megakernel/megakernel.hpp"
+#include "megakernel/megakernel_body.cuh"
+
+namespace wt::cuda {
+
+namespace {
+
+// The 64 KiB of constant memory, less headroom for what the toolchain places there.
+constexpr size_t kPoolBytes = 63 * 1024;
+__constant__ __align__(16) unsigned char c_pool[kPoolBytes];
+
+// Where each array starts in the pool.
+struct ConstantLayout {
+  uint32_t spheres, sphere_material, nodes, materials, textures, images;
+  int32_t sphere_count, node_total;
+};
+
+struct ConstantScene {
+  ConstantLayout layout;
+  Sky sky;
+  Camera camera;
+
+  template <class T>
+  __device__ const T* array(uint32_t offset) const {
+    return reinterpret_cast<const T*>(c_pool + offset);
+  }
+  __device__ int node_count() const { return layout.node_total; }
+  __device__ BvhNode node(int i) const { return array<BvhNode>(layout.nodes)[i]; }
+  __device__ SphereGeom sphere(int i) const { return array<SphereGeom>(layout.spheres)[i]; }
+  __device__ const Material& material_of(int s) const {
+    return array<Material>(layout.materials)[array<uint32_t>(layout.sphere_material)[s]];
+  }
+  __device__ const Texture* texture_array() const { return array<Texture>(layout.textures); }
+  __device__ const ImageView* image_array() const { return array<ImageView>(layout.images); }
+};
+
+ConstantScene g_scene{};  // host copy of the accessor, filled by upload_constant_scene
+
+size_t align16(size_t n) { return (n + 15) & ~size_t(15); }
+
+__global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
+    megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, float* film,
+                        unsigned long long* rays) {
+  megakernel_pixel(scene, rp, first_sample, samples, film, rays);
+}
+
+}  // namespace
+
+size_t constant_scene_capacity() { return kPoolBytes; }
+
+void upload_constant_scene(const Scene& scene, const SceneView& device_view) {
+  std::vector<unsigned char> pool;
+  auto place = [&pool](const void* data, size_t bytes) {
+    size_t offset = align16(pool.size());
+    pool.resize(offset + bytes);
+    if (bytes) std::memcpy(pool.data() + offset, data, bytes);
+    return static_cast<uint32_t>(offset);
+  };
+  ConstantScene cs{};
+  cs.layout.spheres = place(scene.spheres.data(), scene.spheres.size() * sizeof(SphereGeom));
+  cs.layout.sphere_material = place(scene.sphere_material.data(), scene.sphere_material.size() * sizeof(uint32_t));
+  cs.layout.nodes = place(scene.nodes.data(), scene.nodes.size() * sizeof(BvhNode));
+  cs.layout.materials = place(scene.materials.data(), scene.materials.size() * sizeof(Material));
+  cs.layout.textures = place(scene.textures.data(), scene.textures.size() * sizeof(Texture));
+  std::vector<ImageView> images(device_view.images ? scene.images.size() : 0);
+  if (!images.empty()) {
+    WT_CUDA(cudaMemcpy(images.data(), device_view.images, images.size() * sizeof(ImageView), cudaMemcpyDeviceToHost),
+            "constant upload");
+  }
+  cs.layout.images = place(images.data(), images.size() * sizeof(ImageView));
+  if (pool.size() > kPoolBytes) {
+    throw SceneError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
+                     " bytes of constant memory; megakernel-constant holds at most " + std::to_string(kPoolBytes) +
+                     " (use --kernel megakernel)");
+  }
+  cs.layout.sphere_count = device_view.sphere_count;
+  cs.layout.node_total = device_view.node_total;
+  cs.sky = device_view.sky;
+  cs.camera = device_view.camera;
+  WT_CUDA(cudaMemcpyToSymbol(c_pool, pool.data(), pool.size()), "constant upload");
+  g_scene = cs;
+}
+
+void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
+                                unsigned long long* rays, cudaStream_t stream) {
+  megakernel_constant<<<megakernel_grid(rp), dim3(kMegakernelBlockX, kMegakernelBlockY), 0, stream>>>(
+      g_scene, rp, first_sample, samples, film, rays);
+  WT_CUDA_LAUNCHED("megakernel_constant", "megakernel-constant");
+}
+
+}  // namespace wt::cuda

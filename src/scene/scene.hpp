@@ -1,0 +1,63 @@
+// The host-side scene: what a scene file describes, validated and ready to upload.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "wavetrace/scene_view.hpp"
+
+namespace wt {
+
+// A scene or settings error that names the file and the JSON path of the field.
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Image {
+  std::string path;  // as resolved from the scene file
+  int width = 0, height = 0;
+  std::vector<float> texels;  // RGBA, linear, row 0 = top
+};
+
+struct RenderDefaults {
+  int width = 640;
+  int height = 360;
+  int spp = 16;
+  int depth = 10;
+  int roulette_depth = 5;
+  uint32_t seed = 1;
+};
+
+struct Scene {
+  std::string source;  // the scene file
+  CameraSpec camera;
+  Sky sky{SkyKind::Gradient, vec3(1.0f), vec3(0.5f, 0.7f, 1.0f)};
+  RenderDefaults render;
+  std::vector<Image> images;
+  std::vector<Texture> textures;
+  std::vector<Material> materials;
+  std::vector<std::string> material_names;
+  std::vector<SphereGeom> spheres;          // in BVH order once built
+  std::vector<uint32_t> sphere_material;    // per sphere, in BVH order
+  std::vector<BvhNode> nodes;
+
+  // Number of low bits that hold every sort key the scene's materials use (miss key included).
+  int sort_key_bits() const;
+};
+
+// Reads, validates and prepares (BVH built, sort keys set) a scene file.
+// Throws SceneError naming the file and the field.
+Scene load_scene(const std::string& path);
+
+// The same from JSON text; `source` names the file in messages and anchors
+// relative texture paths.
+Scene parse_scene(const std::string& json_text, const std::string& source);
+
+// Builds the BVH over scene.spheres, reordering spheres and sphere_material.
+void build_bvh(Scene& scene);
+
+// A host view of the scene (pointers into `scene`), for the CPU backend.
+SceneView host_view(const Scene& scene, std::vector<ImageView>& image_views);
+
+}  // namespace wt

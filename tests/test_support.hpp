@@ -1,0 +1,26 @@
+// Helpers shared by the tests: where the repository is, and whether a GPU is.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace wt::test {
+
+// The repository root, found from WAVETRACE_ROOT or by walking up from the working
+// directory to the folder that holds scenes/; test data is read relative to it, so
+// the test binary runs from any copy of the tree.
+std::string repo_root();
+
+// Path of a file under the repository root.
+std::string repo_path(const std::string& relative);
+
+bool cuda_available();
+
+}  // namespace wt::test
+
+// GPU tests skip (and say so) where no CUDA device is present.
+#define WT_REQUIRE_CUDA()                                              \
+  do {                                                                 \
+    if (!::wt::test::cuda_available()) GTEST_SKIP() << "no CUDA device"; \
+  } while (0)
