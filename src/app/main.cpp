@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "app/batch.hpp"
+#include "app/bench.hpp"
 #include "app/job.hpp"
 
 namespace {
@@ -61,6 +62,16 @@ int main(int argc, char** argv) {
   batch->add_option("--output-dir", output_dir, "where scene files given directly are rendered to");
   add_render_options(*batch, batch_job, batch_encoding);
 
+  wt::app::BenchOptions bench_options;
+  CLI::App* bench = app.add_subcommand("bench", "time a grid of scenes x configurations x kernels");
+  bench->add_option("spec", bench_options.spec, "bench spec (JSON), e.g. bench/study.json")->required();
+  bench->add_option("-o,--output-dir", bench_options.out_dir, "folder for results.json and results.csv")->required();
+  bench->add_option("--backend", bench_options.backend, "cuda, cpu or auto")->check(CLI::IsMember({"cuda", "cpu", "auto"}));
+  bench->add_option("--only", bench_options.only, "run one group of the spec");
+  bench->add_option("--repeats", bench_options.repeats, "timed runs per point (default: the spec's)")
+      ->check(CLI::Range(1, 100));
+  bench->add_option("--commit", bench_options.commit, "the commit being measured, recorded in the results");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -82,6 +93,15 @@ int main(int argc, char** argv) {
                  o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
                  static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);
     return 0;
+  }
+
+  if (*bench) {
+    try {
+      return wt::app::run_bench(bench_options);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "wavetrace: %s\n", e.what());
+      return wt::app::kExitBadInput;
+    }
   }
 
   set_encoding(batch_job, batch_encoding);

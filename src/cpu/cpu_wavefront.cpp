@@ -5,6 +5,7 @@
 #include <chrono>
 #include <vector>
 
+#include "cpu/cpu_stages.hpp"
 #include "cpu/parallel.hpp"
 #include "stages/stage_items.hpp"
 
@@ -38,7 +39,7 @@ RenderResult render_wavefront(const SceneView& scene, const RenderOptions& optio
   std::vector<float> hit_t(capacity);
   std::vector<int32_t> hit_sphere(capacity);
   const HitQueue hits{hit_t.data(), hit_sphere.data()};
-  std::vector<uint32_t> entries(capacity), selected, list;
+  std::vector<uint32_t> entries(capacity), selected;
   selected.reserve(capacity);
   RenderResult out;
   out.rgb.assign(static_cast<size_t>(rp.width) * rp.height * 3, 0.0f);
@@ -59,12 +60,8 @@ RenderResult render_wavefront(const SceneView& scene, const RenderOptions& optio
     parallel_for(live, kChunk, threads, [&](int64_t b, int64_t e, int) {
       for (int64_t i = b; i < e; ++i) entries[i] = intersect_one(static_cast<uint32_t>(i), scene, rp, q, hits, film);
     });
-    selected.clear();
-    std::copy_if(entries.begin(), entries.begin() + live, std::back_inserter(selected),
-                 [](uint32_t entry) { return entry_key(entry) != kSortKeyMiss; });
-    // Entries hold the key above the slot, so ordering whole entries orders by key
-    // and keeps slot order within a key, as the GPU's key-bits-only radix sort does.
-    if (sorted) std::sort(selected.begin(), selected.end());
+    compact_entries(entries.data(), live, selected);
+    if (sorted) sort_entries(selected);
 
     std::atomic<uint32_t> pushed{0};
     const PathQueue& next_queue = queues[1 - cur].view;

@@ -25,7 +25,7 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
-  if (constant) upload_constant_scene(scene, ds.view());
+  if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   DeviceBuffer<float> film(pixels * 3, kStage);
   DeviceBuffer<unsigned long long> rays(1, kStage);
@@ -78,6 +78,15 @@ size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_si
   return film;
 }
 
+void require_device_memory(const RenderParams& rp, size_t need, size_t free_bytes, const std::string& device) {
+  const size_t usable = free_bytes - std::min(free_bytes, size_t(256) << 20);  // headroom for the runtime
+  if (need > usable) {
+    throw SceneError("width x height: " + std::to_string(rp.width) + " x " + std::to_string(rp.height) +
+                     " with this kernel needs " + mib(need) + " of device memory; " + device + " has " +
+                     mib(free_bytes) + " free");
+  }
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (device_count() == 0) throw SceneError("backend: cuda was asked for, but no CUDA device is present");
   const RenderParams& rp = options.params;
@@ -90,13 +99,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   size_t scene_bytes = 0;
   for (const Image& im : scene.images) scene_bytes += im.texels.size() * sizeof(float);
   scene_bytes += scene.spheres.size() * (sizeof(SphereGeom) + sizeof(uint32_t)) + scene.nodes.size() * sizeof(BvhNode);
-  size_t need = render_state_bytes(rp, options.kernel, wave) + scene_bytes;
-  size_t usable = info.free_memory - std::min(info.free_memory, size_t(256) << 20);  // headroom for the runtime
-  if (need > usable) {
-    throw SceneError("width x height: " + std::to_string(rp.width) + " x " + std::to_string(rp.height) +
-                     " with this kernel needs " + mib(need) + " of device memory; " + info.name + " has " +
-                     mib(info.free_memory) + " free");
-  }
+  require_device_memory(rp, render_state_bytes(rp, options.kernel, wave) + scene_bytes, info.free_memory, info.name);
 
   auto t0 = std::chrono::steady_clock::now();
   DeviceScene ds(scene, rp.width, rp.height);

@@ -4,6 +4,8 @@
 
 #include <cuda_runtime.h>
 
+#include <vector>
+
 #include "scene/scene.hpp"
 
 namespace wt::cuda {
@@ -17,7 +19,8 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
 size_t constant_scene_capacity();
 
 // Copies the scene into __constant__ memory; throws SceneError if it does not fit.
-void upload_constant_scene(const Scene& scene, const SceneView& device_view);
+// `images` are the device image views (texture objects) of the uploaded scene.
+void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images);
 
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
                                 unsigned long long* rays, cudaStream_t stream);

@@ -55,7 +55,7 @@ __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
 
 size_t constant_scene_capacity() { return kPoolBytes; }
 
-void upload_constant_scene(const Scene& scene, const SceneView& device_view) {
+void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images) {
   std::vector<unsigned char> pool;
   auto place = [&pool](const void* data, size_t bytes) {
     size_t offset = align16(pool.size());
@@ -69,11 +69,6 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view) {
   cs.layout.nodes = place(scene.nodes.data(), scene.nodes.size() * sizeof(BvhNode));
   cs.layout.materials = place(scene.materials.data(), scene.materials.size() * sizeof(Material));
   cs.layout.textures = place(scene.textures.data(), scene.textures.size() * sizeof(Texture));
-  std::vector<ImageView> images(device_view.images ? scene.images.size() : 0);
-  if (!images.empty()) {
-    WT_CUDA(cudaMemcpy(images.data(), device_view.images, images.size() * sizeof(ImageView), cudaMemcpyDeviceToHost),
-            "constant upload");
-  }
   cs.layout.images = place(images.data(), images.size() * sizeof(ImageView));
   if (pool.size() > kPoolBytes) {
     throw SceneError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
