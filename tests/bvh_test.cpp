@@ -53,11 +53,18 @@ std::vector<SphereGeom> concentric(int count) {
   return out;
 }
 
-// Centres at geometrically growing distances: equal-width bins peel off one sphere
-// per level, which alone would make a tree as deep as the sphere count.
-std::vector<SphereGeom> geometric_line(int count) {
+// Three chains of centres, one along each axis, each 32 times farther out than the
+// last: equal-width bins can then only peel one sphere off a chain per level, so
+// SAH alone would make a tree about as deep as the sphere count.
+std::vector<SphereGeom> power_chains() {
   std::vector<SphereGeom> out;
-  for (int i = 0; i < count; ++i) out.push_back(SphereGeom{std::pow(1.5f, static_cast<float>(i)), 0, 0, 0.4f});
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int i = 0; i < 25; ++i) {
+      float c[3] = {0, 0, 0};
+      c[axis] = std::ldexp(1.0f, 5 * i);
+      out.push_back(SphereGeom{c[0], c[1], c[2], 0.4f});
+    }
+  }
   return out;
 }
 
@@ -65,7 +72,7 @@ std::vector<SphereSet> sphere_sets() {
   return {{"one", random_spheres(1, 1)},          {"two", random_spheres(2, 2)},
           {"57", random_spheres(3, 57)},          {"500", random_spheres(4, 500)},
           {"ground", ground_and_marbles(5)},      {"concentric", concentric(100)},
-          {"geometric", geometric_line(150)}};
+          {"power chains", power_chains()}};
 }
 
 Hit brute_force(const std::vector<SphereGeom>& spheres, const Ray& ray, float tmin, float tmax) {
@@ -162,7 +169,7 @@ TEST(Bvh, ClosestHitMatchesBruteForce) {
       ASSERT_EQ(scene.sphere_material[got.sphere], static_cast<uint32_t>(expect.sphere));
       ASSERT_EQ(got.t, expect.t);
     }
-    EXPECT_GT(hits, 1000) << "too few rays hit for the comparison to mean much";
+    EXPECT_GT(hits, 400) << "too few rays hit for the comparison to mean much";
   }
 }
 
@@ -211,7 +218,9 @@ TEST(Bvh, NodeBoundsContainTheirChildrenAndSpheres) {
     Scene scene = built(set.spheres);
     walk(scene.nodes, [&](int node, int parent) {
       const BvhNode& n = scene.nodes[node];
-      if (parent >= 0) EXPECT_TRUE(box_contains(scene.nodes[parent], n.lo, n.hi)) << "node " << node;
+      if (parent >= 0) {
+        EXPECT_TRUE(box_contains(scene.nodes[parent], n.lo, n.hi)) << "node " << node;
+      }
       for (int i = n.left_or_first; n.count > 0 && i < n.left_or_first + n.count; ++i) {
         const SphereGeom& s = scene.spheres[i];
         float lo[3] = {s.x - s.w, s.y - s.w, s.z - s.w}, hi[3] = {s.x + s.w, s.y + s.w, s.z + s.w};
@@ -224,7 +233,6 @@ TEST(Bvh, NodeBoundsContainTheirChildrenAndSpheres) {
 TEST(Bvh, DepthStaysBelowTheTraversalStack) {
   std::vector<SphereSet> sets = sphere_sets();
   sets.push_back({"20000", random_spheres(6, 20000)});
-  sets.push_back({"geometric-200", geometric_line(200)});
   for (const SphereSet& set : sets) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);

@@ -42,7 +42,7 @@ struct Scene {
   std::vector<uint32_t> sphere_material;    // per sphere, in BVH order
   std::vector<BvhNode> nodes;
 
-  // Number of low bits that hold every sort key the scene's materials use (miss key included).
+  // Number of low bits that hold every sort key the scene's materials use (at least 1).
   int sort_key_bits() const;
 };
 
