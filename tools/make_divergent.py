@@ -20,15 +20,12 @@ that escape contribute little. Everything comes from random.Random with a
 fixed seed: running the script again writes the identical file.
 """
 
-import argparse
 import collections
-import json
 import math
-import os
 import random
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_OUT = os.path.join(HERE, "..", "scenes", "divergent.json")
+import scenefile  # a sibling: the script's folder is on the path
+
 SEED = 20240611
 
 WIDTH, HEIGHT = 1920, 1080
@@ -49,20 +46,7 @@ KINDS = [
 IMAGES = ["probe_beach", "probe_building", "probe_campus", "probe_kitchen", "planet"]
 
 
-def dumps_scene(scene):
-    """JSON text with one list entry per line: diffs stay readable."""
-    parts = []
-    for key, value in scene.items():
-        if isinstance(value, list):
-            body = ",\n".join("    " + json.dumps(v) for v in value)
-            parts.append("  %s: [\n%s\n  ]" % (json.dumps(key), body))
-        else:
-            parts.append("  %s: %s" % (json.dumps(key), json.dumps(value)))
-    return "{\n" + ",\n".join(parts) + "\n}\n"
-
-
-def q(x):
-    return round(x, 4)
+q = scenefile.rounder(4)
 
 
 def colour(rng, lo=0.05, hi=0.95):
@@ -199,21 +183,12 @@ def build():
     }
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--output", default=DEFAULT_OUT, help="scene file to write")
-    args = ap.parse_args()
-    scene = build()
-    with open(args.output, "w") as f:
-        f.write(dumps_scene(scene))
-    kind_of = {}
-    for m in scene["materials"]:
-        kind_of[m["name"]] = m["name"].rsplit("_", 1)[0]
-    kinds = collections.Counter(kind_of[s["material"]] for s in scene["spheres"])
-    print("%s: %d spheres, %d materials, %d textures" % (
-        os.path.normpath(args.output), len(scene["spheres"]), len(scene["materials"]), len(scene["textures"])))
-    print("  spheres by material: " + ", ".join("%s %d" % kv for kv in sorted(kinds.items())))
+def summary(scene):
+    # A material's kind is its name without the variant number.
+    kinds = scenefile.spheres_by(scene, lambda m: m["name"].rsplit("_", 1)[0])
+    return "%d spheres, %d materials, %d textures\n  spheres by material: %s" % (
+        len(scene["spheres"]), len(scene["materials"]), len(scene["textures"]), scenefile.counts_text(kinds))
 
 
 if __name__ == "__main__":
-    main()
+    scenefile.main(__doc__, build, scenefile.scene_path("divergent.json"), summary)

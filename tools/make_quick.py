@@ -12,25 +12,8 @@ fuzzy metal, glass, a clear-coated diffuse, and an emitter. Russian roulette
 starts early (bounce 3) so that it, too, is exercised within the short depth.
 """
 
-import argparse
-import json
-import os
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_OUT = os.path.join(HERE, "..", "scenes", "quick.json")
-
-
-def dumps_scene(scene):
-    """JSON text with one list entry per line: diffs stay readable."""
-    parts = []
-    for key, value in scene.items():
-        if isinstance(value, list):
-            body = ",\n".join("    " + json.dumps(v) for v in value)
-            parts.append("  %s: [\n%s\n  ]" % (json.dumps(key), body))
-        else:
-            parts.append("  %s: %s" % (json.dumps(key), json.dumps(value)))
-    return "{\n" + ",\n".join(parts) + "\n}\n"
-
+import scenefile  # a sibling: the script's folder is on the path
 
 RADIUS = 0.55
 # (material, x, z): the back row sits wider than the front row, and the camera
@@ -72,16 +55,9 @@ def build():
     }
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--output", default=DEFAULT_OUT, help="scene file to write")
-    args = ap.parse_args()
-    scene = build()
-    with open(args.output, "w") as f:
-        f.write(dumps_scene(scene))
-    print("%s: %d spheres, %d materials" % (os.path.normpath(args.output), len(scene["spheres"]),
-                                            len(scene["materials"])))
+def summary(scene):
+    return "%d spheres, %d materials" % (len(scene["spheres"]), len(scene["materials"]))
 
 
 if __name__ == "__main__":
-    main()
+    scenefile.main(__doc__, build, scenefile.scene_path("quick.json"), summary)

@@ -16,32 +16,16 @@ the same cost to render) but not the same pixels. Running the script again
 writes the identical file.
 """
 
-import argparse
-import collections
 import json
-import os
 import random
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_OUT = os.path.join(HERE, "..", "scenes", "rtiow-cover.json")
+import scenefile  # a sibling: the script's folder is on the path
+
 SEED = 1984
 
 
-def dumps_scene(scene):
-    """JSON text with one list entry per line: diffs stay readable."""
-    parts = []
-    for key, value in scene.items():
-        if isinstance(value, list):
-            body = ",\n".join("    " + json.dumps(v) for v in value)
-            parts.append("  %s: [\n%s\n  ]" % (json.dumps(key), body))
-        else:
-            parts.append("  %s: %s" % (json.dumps(key), json.dumps(value)))
-    return "{\n" + ",\n".join(parts) + "\n}\n"
-
-
-def q(x):
-    """Six decimals: plenty for float32 albedos and positions, and short lines."""
-    return round(x, 6)
+# Six decimals: plenty for float32 albedos and positions, and short lines.
+q = scenefile.rounder(6)
 
 
 class Materials:
@@ -100,19 +84,11 @@ def build():
     }
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--output", default=DEFAULT_OUT, help="scene file to write")
-    args = ap.parse_args()
-    scene = build()
-    with open(args.output, "w") as f:
-        f.write(dumps_scene(scene))
-    by_type = {m["name"]: m["type"] for m in scene["materials"]}
-    kinds = collections.Counter(by_type[s["material"]] for s in scene["spheres"])
-    print("%s: %d spheres (%s), %d materials" % (
-        os.path.normpath(args.output), len(scene["spheres"]),
-        ", ".join("%s %d" % kv for kv in sorted(kinds.items())), len(scene["materials"])))
+def summary(scene):
+    kinds = scenefile.spheres_by(scene, lambda m: m["type"])
+    return "%d spheres (%s), %d materials" % (
+        len(scene["spheres"]), scenefile.counts_text(kinds), len(scene["materials"]))
 
 
 if __name__ == "__main__":
-    main()
+    scenefile.main(__doc__, build, scenefile.scene_path("rtiow-cover.json"), summary)

@@ -14,15 +14,10 @@ Numbers are copied as parsed (Python floats, written back with repr by the json
 module), so every float32 value of the reference survives the round trip.
 """
 
-import argparse
 import collections
-import json
 import math
-import os
-import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_OUT = os.path.join(HERE, "..", "scenes", "seed57.json")
+import scenefile  # a sibling: the script's folder is on the path
 
 # Texture index in the sphere list -> the project's own image. Their order in
 # the scene's texture list keeps the reference's index, so texture i of the
@@ -38,18 +33,6 @@ CHECKER = "ground_checker"
 
 LOOK_FROM = [0, 5, -20]
 LOOK_AT = [0, 0.5, 0]
-
-
-def dumps_scene(scene):
-    """JSON text with one list entry per line: diffs stay readable."""
-    parts = []
-    for key, value in scene.items():
-        if isinstance(value, list):
-            body = ",\n".join("    " + json.dumps(v) for v in value)
-            parts.append("  %s: [\n%s\n  ]" % (json.dumps(key), body))
-        else:
-            parts.append("  %s: %s" % (json.dumps(key), json.dumps(value)))
-    return "{\n" + ",\n".join(parts) + "\n}\n"
 
 
 def material_for(index, s):
@@ -123,23 +106,11 @@ def build(spheres):
     }
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("spheres", help="the reference's sphere list (seed57_spheres.json)")
-    ap.add_argument("-o", "--output", default=DEFAULT_OUT, help="scene file to write")
-    args = ap.parse_args()
-    with open(args.spheres) as f:
-        spheres = json.load(f)
-    try:
-        scene = build(spheres)
-    except ValueError as e:
-        sys.exit("%s: %s" % (args.spheres, e))
-    with open(args.output, "w") as f:
-        f.write(dumps_scene(scene))
+def summary(scene):
     kinds = collections.Counter(m["type"] for m in scene["materials"])
-    print("%s: %d spheres, materials %s" % (os.path.normpath(args.output), len(scene["spheres"]),
-                                              dict(sorted(kinds.items()))))
+    return "%d spheres, materials %s" % (len(scene["spheres"]), dict(sorted(kinds.items())))
 
 
 if __name__ == "__main__":
-    main()
+    scenefile.main(__doc__, build, scenefile.scene_path("seed57.json"), summary,
+                   input_arg=("spheres", "the reference's sphere list (seed57_spheres.json)"))
