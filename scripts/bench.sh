@@ -15,6 +15,7 @@ commit=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["commit
 status=0
 "$bin/wavetrace" bench bench/study.json -o "$results" --commit "$commit" || status=$?
 bash scripts/profile.sh "$bin" "$results" || status=$?
+python3 bench/profile_summary.py "$results" >/dev/null || status=$?
 # PYTHON: an interpreter with matplotlib (Debian's python3-matplotlib is /usr/bin/python3's).
 "${PYTHON:-python3}" bench/plot.py "$results/results.json" --out "$results" || status=$?
 exit $status

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "cuda/cuda_backend.hpp"
+#include "megakernel/megakernel.hpp"
 #include "render/renderer.hpp"
 #include "test_support.hpp"
 
@@ -159,6 +160,30 @@ TEST(RenderSettings, RejectsZeroSamples) {
 TEST(RenderSettings, ConstantMegakernelNeedsCuda) {
   RenderOptions o = options_for(Backend::Cpu, Kernel::MegakernelConstant, 8, 8, 1, 4, 4, 1);
   EXPECT_THROW(render(furnace_scene(), o), SceneError);
+}
+
+TEST(RenderSettings, SceneBeyondConstantMemoryIsRefusedByTheConstantMegakernel) {
+  WT_REQUIRE_CUDA();
+  // 4000 spheres need 80 KB for their geometry alone: more than constant memory holds.
+  std::string spheres;
+  for (int i = 0; i < 4000; ++i) {
+    spheres += std::string(i ? "," : "") + "{\"center\": [" + std::to_string(i % 64) + ", " + std::to_string(i / 64) +
+               ", 0], \"radius\": 0.4, \"material\": \"m\"}";
+  }
+  Scene scene = parse_scene(R"({"camera": {"look_from": [32, 32, 80], "look_at": [32, 32, 0]},
+    "materials": [{"name": "m", "type": "lambertian"}], "spheres": [)" + spheres + "]}",
+                            "big.json");
+  RenderOptions o = options_for(Backend::Cuda, Kernel::MegakernelConstant, 16, 16, 1, 4, 4, 1);
+  try {
+    render(scene, o);
+    FAIL() << "a scene of 4000 spheres was put in constant memory";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("big.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(std::to_string(cuda::constant_scene_capacity())), std::string::npos)
+        << e.what();
+  }
+  o.kernel = Kernel::Megakernel;  // the global-memory kernel takes it
+  EXPECT_NO_THROW(render(scene, o));
 }
 
 TEST(RenderSettings, RenderThatCannotFitDeviceMemoryIsRefusedWithSizes) {

@@ -12,9 +12,6 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   nodes_.upload(scene.nodes, kStage);
   materials_.upload(scene.materials, kStage);
   textures_.upload(scene.textures, kStage);
-  bytes_ = scene.spheres.size() * sizeof(SphereGeom) + scene.sphere_material.size() * sizeof(uint32_t) +
-           scene.nodes.size() * sizeof(BvhNode) + scene.materials.size() * sizeof(Material) +
-           scene.textures.size() * sizeof(Texture);
 
   // Texels are fetched one by one (point sampling) and filtered by the shared
   // bilinear code, so the GPU computes exactly what the CPU computes.
@@ -25,7 +22,6 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
     arrays_.push_back(array);
     const size_t row = static_cast<size_t>(im.width) * 4 * sizeof(float);
     WT_CUDA(cudaMemcpy2DToArray(array, 0, 0, im.texels.data(), row, row, im.height, cudaMemcpyHostToDevice), kStage);
-    bytes_ += row * im.height;
 
     cudaResourceDesc res{};
     res.resType = cudaResourceTypeArray;

@@ -19,7 +19,6 @@ class DeviceScene {
   const SceneView& view() const { return view_; }
   // The host copies of the image views (texture objects filled in), for constant memory.
   const std::vector<ImageView>& image_views() const { return image_views_; }
-  size_t bytes() const { return bytes_; }
 
  private:
   DeviceBuffer<SphereGeom> spheres_;
@@ -32,7 +31,6 @@ class DeviceScene {
   std::vector<cudaTextureObject_t> objects_;
   std::vector<ImageView> image_views_;
   SceneView view_{};
-  size_t bytes_ = 0;
 };
 
 }  // namespace wt::cuda

@@ -15,7 +15,10 @@ namespace wt::cuda {
 namespace {
 
 constexpr const char* kStage = "wavefront";
-constexpr int64_t kDefaultMaxWave = int64_t(1) << 22;
+// Measured on an H100 (seed57, 1920x1080, 300 spp): 1, 2, 4, 8 and 16 Mi slots took
+// 0.238, 0.179, 0.154, 0.146 and 0.141 s. Bigger waves mean fewer bounces, so fewer
+// launches and host round trips; 16 Mi slots take about 1.8 GB.
+constexpr int64_t kDefaultMaxWave = int64_t(1) << 24;
 constexpr int64_t kMinWave = 1024;
 
 // "readback" is the gap while the host reads the counters: the one sync per bounce.
