@@ -2,10 +2,13 @@
 # The whole benchmark on a CUDA machine, in one command: the grid of bench/study.json
 # (each kernel's image checked against the megakernel's before it is timed), the
 # Nsight Compute profiles, and the plots and tables, all under bench/results/.
-#   scripts/bench.sh [BIN_DIR]     (default: build/, built with scripts/build.sh)
+#   scripts/bench.sh [BIN_DIR]     (default: build/, built first by scripts/build.sh)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-bin=${1:-$root/build}
+if [[ $# -eq 0 ]]; then
+  bash "$root/scripts/build.sh"
+fi
+bin=${1:-${WAVETRACE_BUILD:-$root/build}}
 results=${WAVETRACE_RESULTS:-$root/bench/results}
 cd "$root"
 commit=$(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["commit"])' "$bin/build-info.json" 2>/dev/null ||

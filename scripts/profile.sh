@@ -24,6 +24,6 @@ declare -A count=([megakernel]=1 [megakernel-constant]=1 [wavefront]=4 [wavefron
 for kernel in megakernel megakernel-constant wavefront wavefront-unsorted; do
   ncu --clock-control none --metrics "$metrics" -k "${filter[$kernel]}" --launch-skip "${skip[$kernel]}" \
     --launch-count "${count[$kernel]}" --csv --page raw "$bin/wavetrace" "${render[@]}" --kernel "$kernel" \
-    >"$out/profile-$kernel.csv" 2>"$out/profile-$kernel.log" || echo "profile of $kernel failed: see $out/profile-$kernel.log"
+    >"$out/profile-$kernel.csv" || echo "profile of $kernel failed"
 done
 rm -f "$out/profile.png"
