@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Summarises the Nsight Compute profiles written by scripts/profile.sh.
 
-Reads profile-<kernel>.csv (ncu --csv --page raw) from a results folder and writes
-profiles.md there: per profiled launch, registers per thread, achieved occupancy,
+Reads profile-<scene>-<kernel>.csv (ncu --csv --page raw) from a results folder and
+writes profiles.md there: per scene and profiled launch, registers per thread, achieved occupancy,
 warp execution efficiency, DRAM and memory-system throughput and duration. The
 same numbers go to profiles.json for plots and tables.
 """
@@ -11,6 +11,7 @@ import csv
 import json
 import os
 
+SCENES = ["seed57", "divergent"]
 KERNELS = ["megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"]
 COLUMNS = {
     "registers": "launch__registers_per_thread",
@@ -40,7 +41,7 @@ def read_profile(path):
         name = rec["Kernel Name"].split("(")[0].split("::")[-1]
         item = {"launch": name}
         for key, column in COLUMNS.items():
-            item[key] = number(rec[column])
+            item[key] = number(rec[column]) if column in rec else float("nan")
         item["warp_efficiency_pct"] = 100.0 * item["threads_per_warp_instruction"] / 32.0
         out.append(item)
     return out
@@ -48,22 +49,25 @@ def read_profile(path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("results", help="folder holding profile-<kernel>.csv")
+    ap.add_argument("results", help="folder holding profile-<scene>-<kernel>.csv")
     args = ap.parse_args()
     profiles = {}
-    for k in KERNELS:
-        path = os.path.join(args.results, "profile-%s.csv" % k)
-        if os.path.exists(path):
-            profiles[k] = read_profile(path)
+    for scene in SCENES:
+        for k in KERNELS:
+            path = os.path.join(args.results, "profile-%s-%s.csv" % (scene, k))
+            if os.path.exists(path):
+                profiles.setdefault(scene, {})[k] = read_profile(path)
     lines = [
-        "| kernel | launch | registers / thread | achieved occupancy | warp execution efficiency | DRAM throughput | memory throughput | duration |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+        "| scene | kernel | launch | registers / thread | achieved occupancy | warp execution efficiency "
+        "| DRAM throughput | memory throughput | duration |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for k, rows in profiles.items():
-        for r in rows:
-            lines.append("| %s | %s | %d | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.3f ms |" % (
-                k, r["launch"], r["registers"], r["occupancy_pct"], r["warp_efficiency_pct"], r["dram_pct"],
-                r["memory_pct"], r["duration_ns"] / 1e6))
+    for scene, kernels in profiles.items():
+        for k, rows in kernels.items():
+            for r in rows:
+                lines.append("| %s | %s | %s | %d | %.1f%% | %.1f%% | %.1f%% | %.1f%% | %.3f ms |" % (
+                    scene, k, r["launch"], r["registers"], r["occupancy_pct"], r["warp_efficiency_pct"],
+                    r["dram_pct"], r["memory_pct"], r["duration_ns"] / 1e6))
     with open(os.path.join(args.results, "profiles.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     with open(os.path.join(args.results, "profiles.json"), "w") as f:
