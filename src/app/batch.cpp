@@ -5,6 +5,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "queues/path_queue.hpp"
+
 namespace wt::app {
 
 namespace fs = std::filesystem;
@@ -22,7 +24,7 @@ void apply_fields(const json& obj, const std::string& where, const fs::path& bas
   if (!obj.is_object()) throw SceneError(where + ": must be an object");
   for (const auto& [key, value] : obj.items()) {
     const std::string field = where + "/" + key;
-    auto integer = [&](int lo, int hi) {
+    auto integer = [&](int64_t lo, int64_t hi) {
       if (!value.is_number_integer() || value.get<int64_t>() < lo || value.get<int64_t>() > hi) {
         throw SceneError(field + ": must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi));
       }
@@ -35,16 +37,16 @@ void apply_fields(const json& obj, const std::string& where, const fs::path& bas
     if (key == "scene") job.scene = relative_to(base, text());
     else if (key == "output") job.output = relative_to(base, text());
     else if (key == "stats") job.stats = relative_to(base, text());
-    else if (key == "width") job.width = integer(1, 16384);
-    else if (key == "height") job.height = integer(1, 16384);
-    else if (key == "spp") job.spp = integer(1, 1000000);
-    else if (key == "depth") job.depth = integer(1, 1024);
+    else if (key == "width") job.width = integer(1, kMaxImageSide);
+    else if (key == "height") job.height = integer(1, kMaxImageSide);
+    else if (key == "spp") job.spp = integer(1, kMaxSpp);
+    else if (key == "depth") job.depth = integer(1, kMaxPathDepth);
     else if (key == "roulette_depth") job.roulette_depth = integer(0, 1 << 30);
     else if (key == "seed") job.seed = static_cast<uint32_t>(integer(0, 0x7fffffff));
     else if (key == "backend") job.backend = text();
     else if (key == "kernel") job.kernel = text();
     else if (key == "warmup") job.warmup = integer(0, 100);
-    else if (key == "wave_size") job.wave_size = integer(1024, 1 << 27);
+    else if (key == "wave_size") job.wave_size = integer(kMinWaveSlots, static_cast<int64_t>(kMaxWaveSize));
     else if (key == "encoding") {
       std::string e = text();
       if (e != "srgb" && e != "gamma2") throw SceneError(field + ": must be srgb or gamma2");

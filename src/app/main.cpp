@@ -6,6 +6,7 @@
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
+#include "queues/path_queue.hpp"
 
 namespace {
 
@@ -13,10 +14,10 @@ using wt::app::Job;
 
 // The options that render and batch share; they fill `job`.
 void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
-  cmd.add_option("--width", job.width, "image width in pixels")->check(CLI::Range(1, 16384));
-  cmd.add_option("--height", job.height, "image height in pixels")->check(CLI::Range(1, 16384));
-  cmd.add_option("--spp", job.spp, "samples per pixel")->check(CLI::Range(1, 1000000));
-  cmd.add_option("--depth", job.depth, "most rays per path")->check(CLI::Range(1, 1024));
+  cmd.add_option("--width", job.width, "image width in pixels")->check(CLI::Range(1, wt::kMaxImageSide));
+  cmd.add_option("--height", job.height, "image height in pixels")->check(CLI::Range(1, wt::kMaxImageSide));
+  cmd.add_option("--spp", job.spp, "samples per pixel")->check(CLI::Range(1, wt::kMaxSpp));
+  cmd.add_option("--depth", job.depth, "most rays per path")->check(CLI::Range(1, wt::kMaxPathDepth));
   cmd.add_option("--roulette-depth", job.roulette_depth, "Russian roulette from this many bounces on")
       ->check(CLI::Range(0, 1 << 30));
   cmd.add_option("--seed", job.seed, "render seed");
@@ -26,7 +27,7 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
       ->check(CLI::IsMember({"megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"}));
   cmd.add_option("--warmup", job.warmup, "untimed renders before the timed one")->check(CLI::Range(0, 100));
   cmd.add_option("--wave-size", job.wave_size, "wavefront path slots (default: chosen from free memory)")
-      ->check(CLI::Range(int64_t(1024), int64_t(1) << 27));
+      ->check(CLI::Range(wt::kMinWaveSlots, static_cast<int64_t>(wt::kMaxWaveSize)));
   cmd.add_option("--threads", job.threads, "CPU threads (default: all cores)")->check(CLI::Range(1, 1024));
   cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
       ->check(CLI::IsMember({"srgb", "gamma2"}));

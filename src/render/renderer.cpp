@@ -29,10 +29,10 @@ void require_range(const char* name, int64_t value, int64_t lo, int64_t hi) {
 }  // namespace
 
 void validate_params(const RenderParams& p) {
-  require_range("width", p.width, 1, 16384);
-  require_range("height", p.height, 1, 16384);
-  require_range("spp", p.spp, 1, 1000000);
-  require_range("depth", p.depth, 1, 1024);
+  require_range("width", p.width, 1, kMaxImageSide);
+  require_range("height", p.height, 1, kMaxImageSide);
+  require_range("spp", p.spp, 1, kMaxSpp);
+  require_range("depth", p.depth, 1, kMaxPathDepth);
   require_range("roulette_depth", p.roulette_depth, 0, 1 << 30);
   // Path indices are 32-bit on every backend.
   if (static_cast<uint64_t>(p.width) * p.height * p.spp > 0xffffffffull) {

@@ -20,6 +20,13 @@ struct Image {
   std::vector<float> texels;  // RGBA, linear, row 0 = top
 };
 
+// The sane limits of a render's settings, wherever they are given (scene file,
+// command line, jobs file).
+constexpr int kMaxImageSide = 16384;
+constexpr int kMaxSpp = 1000000;
+constexpr int kMaxPathDepth = 1024;
+constexpr int64_t kMinWaveSlots = 1024;  // the most: kMaxWaveSize, set by the sort entry's slot bits
+
 struct RenderDefaults {
   int width = 640;
   int height = 360;

@@ -307,10 +307,10 @@ class SceneReader {
     auto field = [&](const char* key, int64_t lo, int64_t hi, int64_t fallback) {
       return j.contains(key) ? integer(j[key], child(path, key), lo, hi) : fallback;
     };
-    r.width = static_cast<int>(field("width", 1, 16384, r.width));
-    r.height = static_cast<int>(field("height", 1, 16384, r.height));
-    r.spp = static_cast<int>(field("spp", 1, 1000000, r.spp));
-    r.depth = static_cast<int>(field("depth", 1, 1024, r.depth));
+    r.width = static_cast<int>(field("width", 1, kMaxImageSide, r.width));
+    r.height = static_cast<int>(field("height", 1, kMaxImageSide, r.height));
+    r.spp = static_cast<int>(field("spp", 1, kMaxSpp, r.spp));
+    r.depth = static_cast<int>(field("depth", 1, kMaxPathDepth, r.depth));
     r.roulette_depth = static_cast<int>(field("roulette_depth", 0, INT32_MAX, r.roulette_depth));
     r.seed = static_cast<uint32_t>(field("seed", 0, UINT32_MAX, r.seed));
   }
