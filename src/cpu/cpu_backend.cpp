@@ -36,7 +36,6 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
       for (int s = 0; s < rp.spp; ++s) {
         sum += trace_path(view, rp, static_cast<uint32_t>(p), static_cast<uint32_t>(s), local_rays);
       }
-      sum *= 1.0f / static_cast<float>(rp.spp);
       out.rgb[3 * p + 0] = sum.x;
       out.rgb[3 * p + 1] = sum.y;
       out.rgb[3 * p + 2] = sum.z;

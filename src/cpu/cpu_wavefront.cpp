@@ -82,8 +82,6 @@ RenderResult render_wavefront(const SceneView& scene, const RenderOptions& optio
     if (queued == 0 && next_path >= total) break;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const float inv = 1.0f / static_cast<float>(rp.spp);
-  for (float& v : out.rgb) v *= inv;
   return out;
 }
 

@@ -63,8 +63,6 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   WT_CUDA(cudaMemcpy(&counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
   out.rays = counted;
   out.rgb = film.download(kStage);
-  const float inv = 1.0f / static_cast<float>(rp.spp);
-  for (float& v : out.rgb) v *= inv;
   return out;
 }
 

@@ -54,8 +54,11 @@ RenderParams default_params(const Scene& scene) {
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   validate_params(options.params);
-  if (options.backend == Backend::Cuda) return cuda::render(scene, options);
-  return cpu::render(scene, options);
+  RenderResult r = options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
+  // The backends return each pixel's sum over its samples.
+  const float inv = 1.0f / static_cast<float>(options.params.spp);
+  for (float& v : r.rgb) v *= inv;
+  return r;
 }
 
 }  // namespace wt

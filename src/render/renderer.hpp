@@ -36,7 +36,7 @@ struct StageTime {
 };
 
 struct RenderResult {
-  std::vector<float> rgb;  // mean linear radiance per pixel, row 0 = top, RGB
+  std::vector<float> rgb;  // mean linear radiance per pixel, row 0 = top, RGB (a backend returns sums)
   uint64_t rays = 0;       // every ray intersected, counted once
   uint64_t paths = 0;      // pixels x samples
   double seconds = 0;      // the render alone: CUDA events on the GPU, wall clock on the CPU

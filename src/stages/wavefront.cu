@@ -126,8 +126,6 @@ RenderResult render_wavefront(const SceneView& scene, int key_bits, const Render
   WT_CUDA(cudaMemcpy(&final_counters, wave.counters(), sizeof(WaveCounters), cudaMemcpyDeviceToHost), kStage);
   out.rays = final_counters.rays;
   out.rgb = film.download(kStage);
-  const float inv = 1.0f / static_cast<float>(rp.spp);
-  for (float& v : out.rgb) v *= inv;
   return out;
 }
 
