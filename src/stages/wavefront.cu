@@ -16,10 +16,9 @@ namespace {
 
 constexpr const char* kStage = "wavefront";
 // Measured on an H100 (seed57, 1920x1080, 300 spp): 1, 2, 4, 8 and 16 Mi slots took
-// 0.238, 0.179, 0.154, 0.146 and 0.141 s. Bigger waves mean fewer bounces, so fewer
+// 0.232, 0.173, 0.156, 0.144 and 0.141 s (bench/RESULTS.md). Bigger waves mean fewer bounces, so fewer
 // launches and host round trips; 16 Mi slots take about 1.8 GB.
 constexpr int64_t kDefaultMaxWave = int64_t(1) << 24;
-constexpr int64_t kMinWave = 1024;
 
 // "readback" is the gap while the host reads the counters: the one sync per bounce.
 enum StageIndex { kGenerate, kIntersect, kCompact, kReadback, kSort, kShade, kStageCount };
@@ -50,7 +49,7 @@ int64_t choose_wave_size(int64_t requested, const RenderParams& rp, size_t free_
   // A quarter of free memory at most: the film, the scene and the runtime need the rest.
   const int64_t per_slot = static_cast<int64_t>(wavefront_bytes(1 << 20) >> 20) + 1;
   const int64_t by_memory = static_cast<int64_t>(free_memory / 4) / per_slot;
-  return std::max<int64_t>(std::min({total, kDefaultMaxWave, by_memory}), std::min<int64_t>(total, kMinWave));
+  return std::max<int64_t>(std::min({total, kDefaultMaxWave, by_memory}), std::min<int64_t>(total, kMinWaveSlots));
 }
 
 RenderResult render_wavefront(const SceneView& scene, int key_bits, const RenderOptions& options, int64_t wave_size) {
