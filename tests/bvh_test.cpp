@@ -158,7 +158,7 @@ TEST(Bvh, ClosestHitMatchesBruteForce) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
     std::vector<ImageView> images;
-    SceneView view = host_view(scene, images);
+    SceneView view = host_view(scene, 64, 64, images);
     int hits = 0;
     for (const RayCase& rc : random_rays(++seed, set.spheres, 4000)) {
       Hit expect = brute_force(set.spheres, rc.ray, kRayTMin, rc.tmax);
@@ -246,7 +246,7 @@ TEST(Bvh, OneSphereSceneIsASingleLeaf) {
   EXPECT_EQ(scene.nodes[0].count, 1);
   EXPECT_EQ(scene.nodes[0].left_or_first, 0);
   std::vector<ImageView> images;
-  Hit h = intersect_closest(host_view(scene, images), Ray{vec3(1, 2, 0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
+  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(1, 2, 0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
   EXPECT_EQ(h.sphere, 0);
   EXPECT_FLOAT_EQ(h.t, 2.5f);
 }
@@ -266,7 +266,7 @@ TEST(Bvh, NoSpheresGiveAnEmptyTreeThatMissesEverything) {
   Scene scene = built({});
   EXPECT_TRUE(scene.nodes.empty());
   std::vector<ImageView> images;
-  Hit h = intersect_closest(host_view(scene, images), Ray{vec3(0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
+  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
   EXPECT_LT(h.sphere, 0);
 }
 

@@ -547,12 +547,13 @@ TEST(SceneParser, SortKeyBitsHoldEveryMaterialKeyAndNoMore) {
   EXPECT_EQ(load_scene(test::repo_path("scenes/seed57.json")).sort_key_bits(), 4);
 }
 
-TEST(SceneParser, HostViewPointsIntoTheScene) {
+TEST(SceneParser, HostViewPointsIntoTheSceneWithTheRendersCamera) {
   TempDir dir;
   dir.write_png("p.png", 2, 1, {1, 2, 3, 4, 5, 6, 7, 8});
   Scene s = load_scene(dir.write("s.json", image_texture_scene("p.png", "linear").dump()));
   std::vector<ImageView> images;
-  SceneView v = host_view(s, images);
+  // The render's size, not the scene file's defaults, shapes the camera.
+  SceneView v = host_view(s, 160, 90, images);
   EXPECT_EQ(v.spheres, s.spheres.data());
   EXPECT_EQ(v.sphere_material, s.sphere_material.data());
   EXPECT_EQ(v.nodes, s.nodes.data());
@@ -567,7 +568,8 @@ TEST(SceneParser, HostViewPointsIntoTheScene) {
   EXPECT_EQ(images[0].width, 2);
   EXPECT_EQ(images[0].height, 1);
   EXPECT_EQ(v.sky.zenith, s.sky.zenith);
-  Camera c = Camera::make(s.camera, 320, 200);
+  ASSERT_NE(s.render.width, 160);
+  Camera c = Camera::make(s.camera, 160, 90);
   EXPECT_EQ(v.camera.origin, c.origin);
   EXPECT_EQ(v.camera.upper_left, c.upper_left);
   EXPECT_EQ(v.camera.horizontal, c.horizontal);

@@ -5,7 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "queues/path_queue.hpp"
+#include "queues/wave.hpp"
 
 namespace wt::app {
 

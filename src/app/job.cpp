@@ -98,6 +98,9 @@ JobOutcome run_job(const Job& job) {
   } catch (const cuda::CudaError& e) {
     out.exit_code = kExitFailure;
     out.message = std::string("CUDA error: ") + e.what();
+  } catch (const DeviceError& e) {
+    out.exit_code = kExitFailure;
+    out.message = e.what();
   } catch (const std::exception& e) {
     out.exit_code = kExitFailure;
     out.message = e.what();

@@ -6,7 +6,7 @@
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
-#include "queues/path_queue.hpp"
+#include "queues/wave.hpp"
 
 namespace {
 

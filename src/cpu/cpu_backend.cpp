@@ -52,6 +52,7 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
   });
   out.seconds = seconds_since(t0);
   out.rays = rays.load();
+  out.radiance = Radiance::SumOfSamples;
   return out;
 }
 
@@ -63,11 +64,18 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     throw SceneError("kernel: megakernel-constant needs the cuda backend (constant memory is a GPU memory)");
   }
   std::vector<ImageView> images;
-  SceneView view = host_view(scene, images);
-  view.camera = Camera::make(scene.camera, rp.width, rp.height);
+  const SceneView view = host_view(scene, rp.width, rp.height, images);
 
-  RenderResult out = options.kernel == Kernel::Megakernel ? render_megakernel(view, rp, options)
-                                                          : render_wavefront(view, options);
+  RenderResult out;
+  if (options.kernel == Kernel::Megakernel) {
+    // Warm-up renders, as on the GPU, so that timings compare like with like.
+    RenderOptions silent = options;
+    silent.progress = nullptr;
+    for (int i = 0; i < options.warmup; ++i) render_megakernel(view, rp, silent);
+    out = render_megakernel(view, rp, options);
+  } else {
+    out = render_wavefront(view, scene.sort_key_bits(), options, choose_wave_size(options.wave_size, rp));
+  }
   out.paths = static_cast<uint64_t>(rp.width) * rp.height * rp.spp;
   out.device = "CPU (" + std::to_string(thread_count(options.threads)) + " threads)";
   if (options.progress) options.progress(1.0, out.rays, out.seconds);

@@ -1,11 +1,14 @@
+// The wavefront on host threads: stages/wavefront.hpp's driver over the CPU executor.
 #pragma once
 
-#include "render/renderer.hpp"
+#include "render/render_types.hpp"
 
 namespace wt::cpu {
 
-// The wavefront on host threads: the same per-item stage functions as the GPU's,
-// with the standard library's sort and copy_if in place of CUB's.
-RenderResult render_wavefront(const SceneView& scene, const RenderOptions& options);
+// The wave size: the request if given, else the measured default.
+int64_t choose_wave_size(int64_t requested, const RenderParams& rp);
+
+// Renders with a wave of `wave_size` slots; the result holds pixel sums.
+RenderResult render_wavefront(const SceneView& scene, int key_bits, const RenderOptions& options, int64_t wave_size);
 
 }  // namespace wt::cpu

@@ -10,7 +10,7 @@
 #include "cuda/device_scene.hpp"
 #include "cuda/event.hpp"
 #include "megakernel/megakernel.hpp"
-#include "stages/wavefront.hpp"
+#include "cuda/cuda_wavefront.hpp"
 
 namespace wt::cuda {
 
@@ -63,6 +63,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   WT_CUDA(cudaMemcpy(&counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
   out.rays = counted;
   out.rgb = film.download(kStage);
+  out.radiance = Radiance::SumOfSamples;
   return out;
 }
 
@@ -70,7 +71,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
 
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size) {
   size_t film = static_cast<size_t>(rp.width) * rp.height * 3 * sizeof(float);
-  if (kernel == Kernel::Wavefront || kernel == Kernel::WavefrontUnsorted) {
+  if (is_wavefront(kernel)) {
     return film + wavefront_bytes(wave_size);
   }
   return film;
@@ -86,11 +87,11 @@ void require_device_memory(const RenderParams& rp, size_t need, size_t free_byte
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
-  if (device_count() == 0) throw SceneError("backend: cuda was asked for, but no CUDA device is present");
+  if (device_count() == 0) throw DeviceError("backend: cuda was asked for, but no CUDA device is present");
   const RenderParams& rp = options.params;
   DeviceInfo info = device_info();
 
-  const bool wavefront = options.kernel == Kernel::Wavefront || options.kernel == Kernel::WavefrontUnsorted;
+  const bool wavefront = is_wavefront(options.kernel);
   int64_t wave = wavefront ? choose_wave_size(options.wave_size, rp, info.free_memory) : 0;
   // Checked before allocating anything: a render that cannot fit fails with a
   // message rather than with an allocation error halfway through.

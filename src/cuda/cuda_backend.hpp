@@ -1,9 +1,11 @@
 #pragma once
 
-#include "render/renderer.hpp"
+#include "render/render_types.hpp"
+#include "scene/scene.hpp"
 
 namespace wt::cuda {
 
+// Renders on the current CUDA device; the result holds pixel sums (render/renderer.hpp divides).
 RenderResult render(const Scene& scene, const RenderOptions& options);
 
 // Device bytes a render with these settings needs beyond the scene itself.

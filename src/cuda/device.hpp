@@ -3,13 +3,15 @@
 #pragma once
 
 #include <cstddef>
-#include <stdexcept>
 #include <string>
+
+#include "render/errors.hpp"
 
 namespace wt::cuda {
 
-struct CudaError : std::runtime_error {
-  using std::runtime_error::runtime_error;
+// A failed CUDA call or launch: a failure of the device, not of the input.
+struct CudaError : DeviceError {
+  using DeviceError::DeviceError;
 };
 
 // Number of usable CUDA devices; 0 where there is no driver or no device.

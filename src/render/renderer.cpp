@@ -4,6 +4,7 @@
 
 #include "cpu/cpu_backend.hpp"
 #include "cuda/cuda_backend.hpp"
+#include "queues/wave.hpp"
 
 namespace wt {
 
@@ -54,10 +55,14 @@ RenderParams default_params(const Scene& scene) {
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   validate_params(options.params);
+  if (options.wave_size != 0) {
+    require_range("wave_size", options.wave_size, kMinWaveSlots, static_cast<int64_t>(kMaxWaveSize));
+  }
   RenderResult r = options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
-  // The backends return each pixel's sum over its samples.
+  // The backends return each pixel's sum over its samples: the mean is taken here, once.
   const float inv = 1.0f / static_cast<float>(options.params.spp);
   for (float& v : r.rgb) v *= inv;
+  r.radiance = Radiance::MeanOfSamples;
   return r;
 }
 

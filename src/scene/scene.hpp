@@ -25,7 +25,6 @@ struct Image {
 constexpr int kMaxImageSide = 16384;
 constexpr int kMaxSpp = 1000000;
 constexpr int kMaxPathDepth = 1024;
-constexpr int64_t kMinWaveSlots = 1024;  // the most: kMaxWaveSize, set by the sort entry's slot bits
 
 struct RenderDefaults {
   int width = 640;
@@ -64,7 +63,8 @@ Scene parse_scene(const std::string& json_text, const std::string& source);
 // Builds the BVH over scene.spheres, reordering spheres and sphere_material.
 void build_bvh(Scene& scene);
 
-// A host view of the scene (pointers into `scene`), for the CPU backend.
-SceneView host_view(const Scene& scene, std::vector<ImageView>& image_views);
+// A host view of the scene (pointers into `scene`) for a render of width x height,
+// for the CPU backend.
+SceneView host_view(const Scene& scene, int width, int height, std::vector<ImageView>& image_views);
 
 }  // namespace wt

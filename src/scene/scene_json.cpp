@@ -482,7 +482,7 @@ int Scene::sort_key_bits() const {
   return std::max(bits, 1);
 }
 
-SceneView host_view(const Scene& scene, std::vector<ImageView>& image_views) {
+SceneView host_view(const Scene& scene, int width, int height, std::vector<ImageView>& image_views) {
   image_views.clear();
   for (const Image& im : scene.images) image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height});
   SceneView v{};
@@ -495,7 +495,7 @@ SceneView host_view(const Scene& scene, std::vector<ImageView>& image_views) {
   v.sphere_count = static_cast<int32_t>(scene.spheres.size());
   v.node_total = static_cast<int32_t>(scene.nodes.size());
   v.sky = scene.sky;
-  v.camera = Camera::make(scene.camera, scene.render.width, scene.render.height);
+  v.camera = Camera::make(scene.camera, width, height);
   return v;
 }
 

@@ -1,17 +1,110 @@
-// The wavefront renderer on the GPU: the stages of stages.hpp, bounce after bounce,
-// with path regeneration keeping the wave full while paths remain.
+// The wavefront, written once for every backend over an executor that runs named
+// stages: per bounce generate -> intersect -> compact -> (readback) -> sort ->
+// shade, with path regeneration keeping the wave full while paths remain. The host
+// reads the counters back once per bounce (after compact), which tells it how many
+// entries to sort and shade and when every path is done.
+//
+// An executor (cpu/executor.hpp, cuda/executor.cuh) provides:
+//   Memory alloc(bytes, stage)               an owning block with get()
+//   static size_t temp_bytes(capacity)       its compact's and sort's temporary storage
+//   launch(stage, n, item)                   item(i) for every i < n, in parallel
+//   select(stage, in, out, count, n, pred, temp, temp_bytes)  keeps in[i] with pred, in order
+//   sort(stage, keys, alternate, n, bits, temp, temp_bytes) -> the buffer holding the result
+//                                            (stable, over the key bits alone)
+//   read(stage, const T*) -> T               reads a value back to the host
+//   zero(p, bytes), download(const float*, n)
+//   start_timer(), stop_timer() -> seconds, elapsed_host(), take_stage_ms(count)
+// Every launch goes through launch/select/sort/read with its stage, and is timed
+// by the executor under that stage's name.
 #pragma once
 
-#include "render/renderer.hpp"
+#include <array>
+#include <vector>
 
-namespace wt::cuda {
+#include "render/render_types.hpp"
+#include "stages/compact.hpp"
+#include "stages/generate.hpp"
+#include "stages/intersect.hpp"
+#include "stages/shade.hpp"
+#include "stages/sort.hpp"
+#include "stages/stage.hpp"
 
-// Device bytes a wave of this many slots needs (queues, hits, entries, temporaries).
-size_t wavefront_bytes(int64_t wave_size);
+namespace wt {
 
-// The wave size: the request if given (checked), else chosen from free memory.
-int64_t choose_wave_size(int64_t requested, const RenderParams& rp, size_t free_memory);
+// The wavefront's stages, in the order they run. "readback" is the host's one wait
+// per bounce for the counters.
+namespace stage {
+constexpr Stage kGenerate{0, "generate"};
+constexpr Stage kIntersect{1, "intersect"};
+constexpr Stage kCompact{2, "compact"};
+constexpr Stage kReadback{3, "readback"};
+constexpr Stage kSort{4, "sort"};
+constexpr Stage kShade{5, "shade"};
+constexpr std::array<Stage, 6> kAll = {kGenerate, kIntersect, kCompact, kReadback, kSort, kShade};
+}  // namespace stage
 
-RenderResult render_wavefront(const SceneView& scene, int key_bits, const RenderOptions& options, int64_t wave_size);
+// Bytes a wave of `capacity` slots takes on the executor's memory.
+template <class Exec>
+size_t wavefront_bytes(size_t capacity) {
+  return wave_bytes(capacity, Exec::temp_bytes(capacity));
+}
 
-}  // namespace wt::cuda
+// Renders with a wave of `capacity` slots; the result holds pixel sums.
+template <class Exec>
+RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, const RenderOptions& options,
+                              int64_t capacity) {
+  const RenderParams& rp = options.params;
+  const bool sorted = options.kernel == Kernel::Wavefront;
+  const uint32_t total = static_cast<uint32_t>(static_cast<uint64_t>(rp.width) * rp.height * rp.spp);
+  const uint32_t slots = static_cast<uint32_t>(capacity);
+  const size_t film_floats = static_cast<size_t>(rp.width) * rp.height * 3;
+
+  size_t bytes = 0;
+  const size_t temp_bytes = Exec::temp_bytes(slots);
+  auto wave_memory = ex.alloc(wave_bytes(slots, temp_bytes), "wave allocation");
+  const WaveView w = lay_out_wave(wave_memory.get(), slots, temp_bytes, &bytes);
+  auto film_memory = ex.alloc(film_floats * sizeof(float), "wave allocation");
+  float* film = reinterpret_cast<float*>(film_memory.get());
+
+  RenderResult out;
+  auto run = [&](bool report) {
+    ex.zero(film, film_floats * sizeof(float));
+    ex.zero(w.counters, sizeof(WaveCounters));
+    std::vector<uint64_t> live_per_bounce;
+    ex.start_timer();
+    for (int cur = 0;; cur = 1 - cur) {
+      ex.launch(stage::kGenerate, slots, GenerateItem{scene, rp, w.queue[cur], w.counters, cur, total, slots});
+      ex.launch(stage::kIntersect, slots,
+                IntersectItem{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, slots, film});
+      ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
+      ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp, w.temp_bytes);
+      const WaveCounters c = ex.read(stage::kReadback, w.counters);
+      live_per_bounce.push_back(c.queued[cur]);
+
+      const uint32_t* list = w.selected;
+      if (sorted && c.hits > 0) {
+        list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
+      }
+      ex.launch(stage::kShade, c.hits,
+                ShadeItem{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], list, film});
+      if (report) {
+        options.progress(static_cast<double>(c.next_path - c.queued[cur]) / total, c.rays, ex.elapsed_host());
+      }
+      if (c.hits == 0 && c.next_path >= total) break;
+    }
+    out.seconds = ex.stop_timer();
+    const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
+    out.stages.clear();
+    for (const Stage& s : stage::kAll) out.stages.push_back(StageTime{s.name, ms[s.index]});
+    out.live_per_bounce = std::move(live_per_bounce);
+  };
+  for (int i = 0; i < options.warmup; ++i) run(false);
+  run(static_cast<bool>(options.progress));
+
+  out.rays = ex.read(stage::kReadback, w.counters).rays;
+  out.rgb = ex.download(film, film_floats);
+  out.radiance = Radiance::SumOfSamples;
+  return out;
+}
+
+}  // namespace wt

@@ -1,0 +1,17 @@
+// The wavefront on the GPU: stages/wavefront.hpp's driver over the CUDA executor.
+#pragma once
+
+#include "render/render_types.hpp"
+
+namespace wt::cuda {
+
+// Device bytes a wave of this many slots needs (queues, hits, entries, CUB's temporaries).
+size_t wavefront_bytes(int64_t wave_size);
+
+// The wave size: the request if given, else the measured default capped by free memory.
+int64_t choose_wave_size(int64_t requested, const RenderParams& rp, size_t free_memory);
+
+// Renders with a wave of `wave_size` slots; the result holds pixel sums.
+RenderResult render_wavefront(const SceneView& scene, int key_bits, const RenderOptions& options, int64_t wave_size);
+
+}  // namespace wt::cuda

@@ -1,0 +1,189 @@
+// The GPU's executor for the wavefront (stages/wavefront.hpp): a stage is one
+// launch of a generic kernel around the stage's per-item function, with the block
+// size the occupancy API picks for it; compact and sort are CUB's. Every launch is
+// checked and named after its stage, and timed with a pair of CUDA events whose
+// times are collected at the host's next wait. Include from .cu files only.
+#pragma once
+
+#include <cub/device/device_radix_sort.cuh>
+#include <cub/device/device_select.cuh>
+#include <algorithm>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include "cuda/buffer.hpp"
+#include "cuda/event.hpp"
+#include "stages/compact.hpp"
+#include "stages/sort.hpp"
+#include "stages/stage.hpp"
+
+namespace wt::cuda {
+
+template <class Item>
+__global__ void for_each_kernel(Item item, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) item(i);
+}
+
+// The block size that gives for_each_kernel<Item> the highest occupancy, asked once per item type.
+template <class Item>
+int block_size_for(const Stage& s) {
+  static const int block = [&] {
+    int min_grid = 0, size = 0;
+    WT_CUDA(cudaOccupancyMaxPotentialBlockSize(&min_grid, &size, for_each_kernel<Item>), s.name);
+    return size;
+  }();
+  return block;
+}
+
+class Executor {
+ public:
+  explicit Executor(cudaStream_t stream = nullptr) : stream_(stream), timer_("wavefront") {
+    WT_CUDA(cudaMallocHost(&pinned_, kPinnedBytes), "wave allocation");
+  }
+  ~Executor() { cudaFreeHost(pinned_); }
+  Executor(const Executor&) = delete;
+  Executor& operator=(const Executor&) = delete;
+
+  DeviceBuffer<unsigned char> alloc(size_t bytes, const char* stage) { return DeviceBuffer<unsigned char>(bytes, stage); }
+
+  // The most temporary storage compact (over `capacity` entries) and sort need.
+  static size_t temp_bytes(size_t capacity) {
+    size_t select = 0, sort = 0;
+    const int64_t n = static_cast<int64_t>(capacity);
+    WT_CUDA(cub::DeviceSelect::If(nullptr, select, static_cast<const uint32_t*>(nullptr),
+                                  static_cast<uint32_t*>(nullptr), static_cast<uint32_t*>(nullptr), n,
+                                  HitSomething{}),
+            "compact");
+    cub::DoubleBuffer<uint32_t> keys(nullptr, nullptr);
+    WT_CUDA(cub::DeviceRadixSort::SortKeys(nullptr, sort, keys, n, 0, 32), "sort");
+    return std::max(select, sort);
+  }
+
+  template <class Item>
+  void launch(const Stage& s, uint32_t n, const Item& item) {
+    if (n == 0) return;
+    const int block = block_size_for<Item>(s);
+    timed(s, [&] {
+      for_each_kernel<<<(n + block - 1) / block, block, 0, stream_>>>(item, n);
+      check(static_cast<int>(cudaGetLastError()), "kernel launch", s.name);
+    });
+  }
+
+  template <class Pred>
+  void select(const Stage& s, const uint32_t* in, uint32_t* out, uint32_t* count, uint32_t n, Pred pred, void* temp,
+              size_t temp_bytes) {
+    timed(s, [&] {
+      size_t bytes = temp_bytes;
+      WT_CUDA(cub::DeviceSelect::If(temp, bytes, in, out, count, static_cast<int64_t>(n), pred, stream_), s.name);
+    });
+  }
+
+  // The sorted entries end in `keys` or `alternate`, whichever CUB's double buffer says.
+  const uint32_t* sort(const Stage& s, uint32_t* keys, uint32_t* alternate, uint32_t n, SortBits bits, void* temp,
+                       size_t temp_bytes) {
+    cub::DoubleBuffer<uint32_t> buffers(keys, alternate);
+    timed(s, [&] {
+      size_t bytes = temp_bytes;
+      WT_CUDA(cub::DeviceRadixSort::SortKeys(temp, bytes, buffers, static_cast<int64_t>(n), bits.begin, bits.end,
+                                             stream_),
+              s.name);
+    });
+    return buffers.Current();
+  }
+
+  // Copies *p to the host and waits for it: the one wait per bounce. The stage's
+  // time runs until the host is back, and the waiting lets every earlier stage's
+  // events be read.
+  template <class T>
+  T read(const Stage& s, const T* p) {
+    static_assert(sizeof(T) <= kPinnedBytes, "read() reads small values");
+    Event& begin = next_event();
+    begin.record(s.name, stream_);
+    WT_CUDA(cudaMemcpyAsync(pinned_, p, sizeof(T), cudaMemcpyDeviceToHost, stream_), s.name);
+    WT_CUDA(cudaStreamSynchronize(stream_), s.name);
+    collect();
+    Event& end = next_event();
+    end.record(s.name, stream_);
+    pending_.push_back(Pending{s.index, &begin, &end});
+    T value;
+    std::memcpy(&value, pinned_, sizeof(T));
+    return value;
+  }
+
+  void zero(void* p, size_t bytes) { WT_CUDA(cudaMemsetAsync(p, 0, bytes, stream_), "wavefront"); }
+
+  std::vector<float> download(const float* p, size_t n) {
+    std::vector<float> host(n);
+    WT_CUDA(cudaMemcpyAsync(host.data(), p, n * sizeof(float), cudaMemcpyDeviceToHost, stream_), "wavefront");
+    WT_CUDA(cudaStreamSynchronize(stream_), "wavefront");
+    return host;
+  }
+
+  void start_timer() { timer_.start(stream_); }
+  double stop_timer() {
+    const double seconds = timer_.stop(stream_);
+    collect();
+    return seconds;
+  }
+  double elapsed_host() const { return timer_.elapsed_host(); }
+
+  // Each stage's milliseconds since the last call, by stage index. Call after stop_timer().
+  std::vector<double> take_stage_ms(size_t stages) {
+    std::vector<double> ms(stages, 0.0);
+    for (size_t i = 0; i < stages && i < ms_.size(); ++i) ms[i] = ms_[i];
+    ms_.clear();
+    return ms;
+  }
+
+ private:
+  static constexpr size_t kPinnedBytes = 256;
+
+  struct Pending {
+    int stage;
+    Event* begin;
+    Event* end;
+  };
+
+  template <class F>
+  void timed(const Stage& s, F&& f) {
+    Event& begin = next_event();
+    begin.record(s.name, stream_);
+    f();
+    Event& end = next_event();
+    end.record(s.name, stream_);
+    pending_.push_back(Pending{s.index, &begin, &end});
+  }
+
+  Event& next_event() {
+    if (free_.empty()) {
+      events_.push_back(std::make_unique<Event>());
+      return *events_.back();
+    }
+    Event* e = free_.back();
+    free_.pop_back();
+    return *e;
+  }
+
+  // Adds the times of every pending stage (all complete: the stream was waited on).
+  void collect() {
+    for (const Pending& p : pending_) {
+      if (ms_.size() <= static_cast<size_t>(p.stage)) ms_.resize(p.stage + 1, 0.0);
+      ms_[p.stage] += p.end->ms_since(*p.begin, "wavefront timing");
+      free_.push_back(p.begin);
+      free_.push_back(p.end);
+    }
+    pending_.clear();
+  }
+
+  cudaStream_t stream_;
+  EventTimer timer_;
+  void* pinned_ = nullptr;
+  std::vector<std::unique_ptr<Event>> events_;
+  std::vector<Event*> free_;
+  std::vector<Pending> pending_;
+  std::vector<double> ms_;
+};
+
+}  // namespace wt::cuda

@@ -1,0 +1,67 @@
+// intersect: each live ray's closest hit and its sort entry (the material's sort key
+// above the slot). A miss adds the sky to the film, ends the path and gets the miss
+// key, which compact drops. Then the counters advance (rays, next path) and the
+// other queue is emptied for shade's pushes.
+#pragma once
+
+#include "queues/wave.hpp"
+#include "stages/accumulate.hpp"
+#include "wavetrace/path.hpp"
+
+namespace wt {
+
+template <class Scene>
+WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Scene& scene, const RenderParams& rp, const PathQueue& q,
+                                       const HitQueue& hits, float* film) {
+  Ray ray{vec3(q.ox[i], q.oy[i], q.oz[i]), vec3(q.dx[i], q.dy[i], q.dz[i])};
+  Hit h = intersect_scene(scene, ray);
+  hits.store(i, h);
+  if (h.sphere < 0) {
+    const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
+    vec3 t(q.tr[i], q.tg[i], q.tb[i]);
+    accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir));
+    return pack_entry(kSortKeyMiss, i);
+  }
+  return pack_entry(scene.material_of(h.sphere).sort_key, i);
+}
+
+// Over every slot of the wave: slots past the live ones get a miss entry, so that
+// compact, which runs over the whole capacity without the host knowing the count,
+// drops them.
+struct IntersectItem {
+  SceneView scene;
+  RenderParams rp;
+  PathQueue queue;
+  HitQueue hits;
+  uint32_t* entries;
+  const WaveCounters* counters;
+  int cur;
+  uint32_t total_paths;
+  uint32_t capacity;
+  float* film;
+
+  WT_HD void operator()(uint32_t i) const {
+    const uint32_t live = live_paths(counters->queued[cur], counters->next_path, total_paths, capacity);
+    entries[i] = i < live ? intersect_one(i, scene, rp, queue, hits, film) : pack_entry(kSortKeyMiss, i);
+  }
+};
+
+// One item, launched after every intersect item has read the counters.
+struct AdvanceCountersItem {
+  WaveCounters* counters;
+  int cur;
+  uint32_t total_paths;
+  uint32_t capacity;
+
+  WT_HD void operator()(uint32_t) const {
+    WaveCounters& c = *counters;
+    const uint32_t queued = c.queued[cur];
+    const uint32_t live = live_paths(queued, c.next_path, total_paths, capacity);
+    c.rays += live;
+    c.next_path += live - queued;
+    c.queued[cur] = live;
+    c.queued[1 - cur] = 0;
+  }
+};
+
+}  // namespace wt
