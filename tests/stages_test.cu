@@ -156,16 +156,19 @@ void upload_slots(const PathQueue& q, const std::vector<PathState>& states) {
 #undef WT_TEST_FIELD
 }
 
-// ---------- generate ----------
+// ---------- generate (inside intersect's launch) ----------
 
-TYPED_TEST(Stages, GenerateFillsFreeSlotsWithConsecutivePathsMatchingTheCamera) {
+TYPED_TEST(Stages, IntersectStartsCameraPathsInTheFreeSlots) {
   using Side = TypeParam;
   Scene scene = stage_scene();
   typename Side::SceneData sd(scene, kParams.width, kParams.height);
   WaveView w = this->wave(16);
-  // 5 paths wait in slots 0..4; the free slots 5..15 start paths 40..50.
+  float* film = this->template array<float>(kPixels * 3);
+  // 5 paths wait in slots 0..4 (all zero: rays from the origin along nothing, path
+  // 0); the free slots 5..15 start paths 40..50.
   Side::upload(w.counters, std::vector<WaveCounters>{WaveCounters{{5, 0}, 40, 0, 0}});
-  this->ex->launch(stage::kGenerate, 16, GenerateItem{sd.view, kParams, w.queue[0], w.counters, 0, kTotal, 16});
+  this->ex->launch(stage::kIntersect, 16,
+                   IntersectItem{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 16, film});
   std::vector<ImageView> images;
   const SceneView host = host_view(scene, kParams.width, kParams.height, images);
   for (uint32_t slot = 5; slot < 16; ++slot) {
@@ -181,6 +184,19 @@ TYPED_TEST(Stages, GenerateFillsFreeSlotsWithConsecutivePathsMatchingTheCamera) 
   }
   // The waiting paths' slots are left alone.
   for (uint32_t slot = 0; slot < 5; ++slot) EXPECT_EQ(download_slot<Side>(w.queue[0], slot).path, 0u);
+}
+
+TEST(GenerateStage, StartPathIsTheCameraRayOfTheSlotsPath) {
+  Scene scene = stage_scene();
+  std::vector<ImageView> images;
+  const SceneView view = host_view(scene, kParams.width, kParams.height, images);
+  const PathState s = start_path(9, 5, 40, view, kParams);
+  EXPECT_EQ(s.path, 44u);
+  EXPECT_EQ(s.bounce, 0u);
+  EXPECT_EQ(s.throughput, vec3(1.0f));
+  const Ray expect = primary_ray(view, kParams, 44 % kPixels, 44 / kPixels);
+  EXPECT_EQ(s.ray.origin, expect.origin);
+  EXPECT_EQ(s.ray.dir, expect.dir);
 }
 
 TEST(GenerateStage, EveryPathIsGeneratedExactlyOnceAcrossWaves) {
@@ -331,7 +347,7 @@ struct ShadeCase {
       rays[i].bounce = 1;
       rays[i].path = 7 + i;
       q.store(i, rays[i]);
-      intersect_one(i, view, kParams, q, hits, film.data());
+      intersect_one(i, rays[i].ray, view, kParams, q, hits, film.data());
     }
   }
 };

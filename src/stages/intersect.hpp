@@ -1,19 +1,21 @@
 // intersect: each live ray's closest hit and its sort entry (the material's sort key
-// above the slot). A miss adds the sky to the film, ends the path and gets the miss
-// key, which compact drops. Then the counters advance (rays, next path) and the
-// other queue is emptied for shade's pushes.
+// above the slot). Free slots first start their camera paths (generate, fused here).
+// A miss adds the sky to the film, ends the path and gets the miss key, which
+// compact drops. Then the counters advance (rays, next path) and the other queue is
+// emptied for shade's pushes.
 #pragma once
 
 #include "queues/wave.hpp"
 #include "stages/accumulate.hpp"
+#include "stages/generate.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt {
 
+// Slot i's ray is `ray`; on a miss the path's index and throughput are read from the queue.
 template <class Scene>
-WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Scene& scene, const RenderParams& rp, const PathQueue& q,
-                                       const HitQueue& hits, float* film) {
-  Ray ray{vec3(q.ox[i], q.oy[i], q.oz[i]), vec3(q.dx[i], q.dy[i], q.dz[i])};
+WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& scene, const RenderParams& rp,
+                                       const PathQueue& q, const HitQueue& hits, float* film) {
   Hit h = intersect_scene(scene, ray);
   hits.store(i, h);
   if (h.sphere < 0) {
@@ -25,9 +27,14 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Scene& scene, const Ren
   return pack_entry(scene.material_of(h.sphere).sort_key, i);
 }
 
-// Over every slot of the wave: slots past the live ones get a miss entry, so that
-// compact, which runs over the whole capacity without the host knowing the count,
-// drops them.
+// Slot i's ray as the queue holds it.
+WT_HD WT_INLINE Ray queued_ray(const PathQueue& q, uint32_t i) {
+  return Ray{vec3(q.ox[i], q.oy[i], q.oz[i]), vec3(q.dx[i], q.dy[i], q.dz[i])};
+}
+
+// Over every slot of the wave: free slots start a path, then every live slot's ray
+// is traced. Slots past the live ones get a miss entry, so that compact, which runs
+// over the whole capacity without the host knowing the count, drops them.
 struct IntersectItem {
   SceneView scene;
   RenderParams rp;
@@ -41,8 +48,21 @@ struct IntersectItem {
   float* film;
 
   WT_HD void operator()(uint32_t i) const {
-    const uint32_t live = live_paths(counters->queued[cur], counters->next_path, total_paths, capacity);
-    entries[i] = i < live ? intersect_one(i, scene, rp, queue, hits, film) : pack_entry(kSortKeyMiss, i);
+    const uint32_t queued = counters->queued[cur];
+    const uint32_t next_path = counters->next_path;
+    if (i >= live_paths(queued, next_path, total_paths, capacity)) {
+      entries[i] = pack_entry(kSortKeyMiss, i);
+      return;
+    }
+    Ray ray;
+    if (i >= queued) {
+      const PathState s = start_path(i, queued, next_path, scene, rp);
+      queue.store(i, s);
+      ray = s.ray;
+    } else {
+      ray = queued_ray(queue, i);
+    }
+    entries[i] = intersect_one(i, ray, scene, rp, queue, hits, film);
   }
 };
 

@@ -1,5 +1,5 @@
 // The wavefront, written once for every backend over an executor that runs named
-// stages: per bounce generate -> intersect -> compact -> (readback) -> sort ->
+// stages: per bounce (generate +) intersect -> compact -> (readback) -> sort ->
 // shade, with path regeneration keeping the wave full while paths remain. The host
 // reads the counters back once per bounce (after compact), which tells it how many
 // entries to sort and shade and when every path is done.
@@ -34,13 +34,12 @@ namespace wt {
 // The wavefront's stages, in the order they run. "readback" is the host's one wait
 // per bounce for the counters.
 namespace stage {
-constexpr Stage kGenerate{0, "generate"};
-constexpr Stage kIntersect{1, "intersect"};
-constexpr Stage kCompact{2, "compact"};
-constexpr Stage kReadback{3, "readback"};
-constexpr Stage kSort{4, "sort"};
-constexpr Stage kShade{5, "shade"};
-constexpr std::array<Stage, 6> kAll = {kGenerate, kIntersect, kCompact, kReadback, kSort, kShade};
+constexpr Stage kIntersect{0, "intersect"};
+constexpr Stage kCompact{1, "compact"};
+constexpr Stage kReadback{2, "readback"};
+constexpr Stage kSort{3, "sort"};
+constexpr Stage kShade{4, "shade"};
+constexpr std::array<Stage, 5> kAll = {kIntersect, kCompact, kReadback, kSort, kShade};
 }  // namespace stage
 
 // Bytes a wave of `capacity` slots takes on the executor's memory.
@@ -73,7 +72,6 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
     std::vector<uint64_t> live_per_bounce;
     ex.start_timer();
     for (int cur = 0;; cur = 1 - cur) {
-      ex.launch(stage::kGenerate, slots, GenerateItem{scene, rp, w.queue[cur], w.counters, cur, total, slots});
       ex.launch(stage::kIntersect, slots,
                 IntersectItem{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, slots, film});
       ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
