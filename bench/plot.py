@@ -44,9 +44,10 @@ REFERENCE_ROWS = [
     ("study's code, constant memory", "H100 SXM", 10.06, 61.8),
 ]
 
-KERNEL_ORDER = ["megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"]
-# Colour and marker per kernel, the same in every figure. Kernels not listed here
-# (added to the bench later) get the extra styles in turn.
+# The kernels and the wavefront's stages come from the results: the bench writes
+# the command's kernel list ("kernels") and the stages in the order they run
+# ("stages"). Colour and marker per kernel, the same in every figure. Kernels not
+# listed here (added to the bench later) get the extra styles in turn.
 KERNEL_STYLE = {
     "megakernel": ("#1f77b4", "o"),
     "megakernel-constant": ("#17becf", "s"),
@@ -55,8 +56,11 @@ KERNEL_STYLE = {
 }
 EXTRA_STYLES = [("#2ca02c", "D"), ("#9467bd", "P"), ("#8c564b", "X"), ("#e377c2", "*")]
 
-STAGES = ["generate", "intersect", "compact", "readback", "sort", "shade"]
-STAGE_COLORS = ["#8dd3c7", "#4575b4", "#fdb462", "#969696", "#e7298a", "#66a61e"]
+# Colour per stage. A stage not listed here is drawn in an extra colour, with a
+# warning: never left out.
+STAGE_COLORS = {"generate": "#8dd3c7", "intersect": "#4575b4", "compact": "#fdb462", "readback": "#969696",
+                "sort": "#e7298a", "shade": "#66a61e"}
+EXTRA_STAGE_COLORS = ["#b15928", "#6a3d9a", "#ffff99", "#1b9e77", "#e6ab02", "#a6761d"]
 
 plt.rcParams.update({
     "font.size": 10,
@@ -129,6 +133,28 @@ def scene_name(path):
     return os.path.basename(path or "") or "?"
 
 
+def stages_of(doc, points):
+    """The stages in the order they run, and a colour for each. From the results'
+    "stages" list, with any further stage a row names; results written before the
+    list was kept give the known stages in their order, then the others."""
+    stages = [s for s in doc.get("stages") or [] if isinstance(s, str)]
+    listed = bool(stages)
+    for p in points:
+        if isinstance(p.get("stage_ms"), dict):
+            stages += [s for s in p["stage_ms"] if s not in stages]
+    if not listed:
+        known = list(STAGE_COLORS)
+        stages.sort(key=lambda s: known.index(s) if s in known else len(known))
+    extra = iter(EXTRA_STAGE_COLORS * 4)
+    colors = {}
+    for s in stages:
+        colors[s] = STAGE_COLORS.get(s)
+        if colors[s] is None:
+            colors[s] = next(extra)
+            print(f"plot.py: WARNING: stage '{s}' has no colour of its own; drawn in {colors[s]}", file=sys.stderr)
+    return stages, colors
+
+
 class Results:
     def __init__(self, doc):
         self.header = {k: v for k, v in doc.items() if k != "points"}
@@ -144,9 +170,12 @@ class Results:
             if k not in kernels:
                 kernels.append(k)
             self.by_key[(g, config_of(p), k)] = p
-        self.kernels = [k for k in KERNEL_ORDER if k in kernels] + [k for k in kernels if k not in KERNEL_ORDER]
+        listed = [k for k in doc.get("kernels") or [] if isinstance(k, str)]
+        self.kernels = [k for k in listed if k in kernels] + [k for k in kernels if k not in listed]
         extra = iter(EXTRA_STYLES * 4)
         self.style = {k: KERNEL_STYLE.get(k) or next(extra) for k in self.kernels}
+        self.stages, self.stage_color = stages_of(doc, self.points)
+
 
     def get(self, group, cfg, kernel):
         return self.by_key.get((group, cfg, kernel))
@@ -567,7 +596,8 @@ def plot_stages(res, out):
             mark_missing(ax, xs[i], p)
             continue
         bottom = 0.0
-        for s, color in zip(STAGES, STAGE_COLORS):
+        for s in res.stages:
+            color = res.stage_color[s]
             v = (number(stage_ms.get(s)) or 0) / 1000
             ax.bar(xs[i], v, 0.6, bottom=bottom, color=color, edgecolor="white", linewidth=0.5)
             bottom += v
@@ -576,8 +606,8 @@ def plot_stages(res, out):
         top = max(top, bottom, seconds(p))
     # Legend entries top to bottom in the order the stages are stacked.
     ax.plot(np.nan, np.nan, marker="_", ms=20, mew=2, color="black", ls="none", label="render time (median)")
-    for s, color in reversed(list(zip(STAGES, STAGE_COLORS))):
-        ax.bar(np.nan, np.nan, color=color, label=s)
+    for s in reversed(res.stages):
+        ax.bar(np.nan, np.nan, color=res.stage_color[s], label=s)
     per_group = max(len(kernels), 1)
     for b in range(per_group, len(bars), per_group):
         ax.axvline(b - 0.5, color="#bbbbbb", lw=1)
@@ -715,7 +745,7 @@ def tables_md(res):
             f"image at {chk.get('spp', '?')} spp, bound {chk.get('max_mean_abs_diff', '?')}.", ""]
 
     out += ["## Wavefront stages (ms, summed over iterations, from the median run)", ""]
-    head = ["group", "WxH", "spp/depth", "kernel"] + STAGES + ["sum", "render ms (median)", "iterations"]
+    head = ["group", "WxH", "spp/depth", "kernel"] + res.stages + ["sum", "render ms (median)", "iterations"]
     body = []
     for p in points:
         if not str(p.get("kernel", "")).startswith("wavefront"):
@@ -725,9 +755,9 @@ def tables_md(res):
         if not ok(p) or not isinstance(stage_ms, dict):
             body.append([p.get("group", "?"), res_label(c), f"{c[2]}/{c[3]}", p.get("kernel", "?")]
                         + [f"FAILED: {short_status(p)}" if not ok(p) else "no stage times"]
-                        + [""] * (len(STAGES) + 2))
+                        + [""] * (len(res.stages) + 2))
             continue
-        vals = [number(stage_ms.get(s)) for s in STAGES]
+        vals = [number(stage_ms.get(s)) for s in res.stages]
         live = p.get("live_per_bounce")
         body.append([p.get("group", "?"), res_label(c), f"{c[2]}/{c[3]}", p.get("kernel", "?")]
                     + ["—" if v is None else f"{v:.1f}" for v in vals]

@@ -29,7 +29,9 @@ for t in "$bin"/*_tests; do
 done
 
 renders=0 render_failed=0
-for kernel in megakernel megakernel-constant wavefront wavefront-unsorted; do
+# The kernel list is the command's own; a binary that cannot list them fails a render.
+kernels=$("$bin/wavetrace" kernels --backend cuda) || render_failed=$((render_failed + 1))
+for kernel in $kernels; do
   if "$bin/wavetrace" render scenes/seed57.json -o "$out/seed57-$kernel.png" --width 640 --height 360 --spp 16 \
     --backend cuda --kernel "$kernel" --stats "$out/seed57-$kernel.json" -q; then
     renders=$((renders + 1))

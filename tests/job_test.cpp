@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/batch.hpp"
+#include "app/bench.hpp"
 #include "app/job.hpp"
 #include "test_support.hpp"
 
@@ -78,6 +79,11 @@ TEST_F(JobTest, GoodJobWritesImageAndStats) {
   for (const char* key : {"scene", "settings", "backend", "kernel", "device", "seconds", "m_rays_per_s", "m_paths_per_s"}) {
     EXPECT_TRUE(stats.contains(key)) << key;
   }
+  for (const char* phase : {"parse", "validate", "texture_load", "bvh_build", "upload"}) {
+    ASSERT_TRUE(stats["load_seconds"].contains(phase)) << phase;
+    EXPECT_GE(stats["load_seconds"][phase].get<double>(), 0.0) << phase;
+  }
+  EXPECT_GT(stats["load_seconds"]["parse"].get<double>(), 0.0);
   EXPECT_TRUE(only_expected_files({"s.json", "out.png", "stats.json"}));
 }
 
@@ -175,6 +181,123 @@ TEST_F(JobTest, BatchOfGoodJobsSucceeds) {
 TEST_F(JobTest, MalformedJobsFileIsRejected) {
   std::string jobs = write("jobs.json", R"({"jobs": [)");
   EXPECT_THROW(read_jobs_file(jobs, Job{}), SceneError);
+}
+
+// What a reader threw, or "" when it did not.
+template <class F>
+std::string error_of(F&& read) {
+  try {
+    read();
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(JobTest, JobsFilesTakeTheSettingsTableRanges) {
+  std::string jobs = write("jobs.json", R"({"jobs": [
+    {"scene": "s.json", "output": "a.png", "seed": 4294967295, "roulette_depth": 1073741824, "threads": 3},
+    {"scene": "s.json", "output": "b.png", "seed": 4294967296},
+    {"scene": "s.json", "output": "c.png", "roulette_depth": 1073741825},
+    {"scene": "s.json", "output": "d.png", "kernel": "megakernal"}]})");
+  std::vector<PlannedJob> planned = read_jobs_file(jobs, Job{});
+  ASSERT_EQ(planned.size(), 4u);
+  EXPECT_EQ(planned[0].error, "");
+  EXPECT_EQ(planned[0].job.seed, 4294967295);
+  EXPECT_EQ(planned[0].job.roulette_depth, 1 << 30);
+  EXPECT_EQ(planned[0].job.threads, 3);
+  EXPECT_EQ(planned[1].error, jobs + ": /jobs/1/seed: must be an integer in 0..4294967295 (got 4294967296)");
+  EXPECT_EQ(planned[2].error,
+            jobs + ": /jobs/2/roulette_depth: must be an integer in 0..1073741824 (got 1073741825)");
+  EXPECT_NE(planned[3].error.find("/jobs/3/kernel: unknown value 'megakernal' (expected megakernel, "),
+            std::string::npos)
+      << planned[3].error;
+}
+
+TEST_F(JobTest, SceneFilesAndRenderSettingsShareTheRanges) {
+  // The same roulette_depth and seed limits as the jobs file above.
+  std::string text = kTinyScene;
+  text.insert(text.rfind('}'), R"(, "render": {"seed": 4294967295, "roulette_depth": 1073741825})");
+  std::string scene = write("s.json", text);
+  EXPECT_EQ(error_of([&] { load_scene(scene); }),
+            scene + ": /render/roulette_depth: must be an integer in 0..1073741824 (got 1073741825)");
+  RenderParams p = RenderDefaults();
+  p.roulette_depth = (1 << 30) + 1;
+  EXPECT_EQ(error_of([&] { validate_params(p); }), "roulette_depth: must be in 0..1073741824 (got 1073741825)");
+  p.roulette_depth = 1 << 30;
+  p.seed = 4294967295u;
+  EXPECT_EQ(error_of([&] { validate_params(p); }), "");
+}
+
+TEST_F(JobTest, JobsFilesRejectRepeatedAndUnknownKeys) {
+  std::string jobs = write("jobs.json", R"({"jobs": [{"scene": "a.json", "scene": "b.json", "output": "o.png"}]})");
+  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }), jobs + ": /jobs/0/scene: duplicate key");
+  jobs = write("jobs.json", R"({"jobs": [], "default": {}})");
+  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }),
+            jobs + ": /default: unknown key (expected jobs, defaults)");
+  jobs = write("jobs.json", R"({"defaults": {"spp": "many"}, "jobs": []})");
+  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }),
+            jobs + ": /defaults/spp: must be an integer in 1..1000000 (got string)");
+}
+
+const char* kSpec = R"({"warmup": 0, "repeats": 5, "check_spp": 1, "check_bound": 0.01,
+  "groups": [
+    {"name": "a", "scene": "scenes/s.json", "kernels": ["megakernel", "wavefront"],
+     "configs": [{"width": 64, "height": 32, "spp": 2, "depth": 5},
+                 {"width": 8, "height": 8, "spp": 1, "depth": 9, "roulette_depth": 3, "seed": 4294967295}]},
+    {"name": "b", "scene": "t.json", "kernels": ["wavefront-unsorted"],
+     "configs": [{"width": 16, "height": 16, "spp": 4, "depth": 2}]}]})";
+
+TEST_F(JobTest, BenchSpecIsReadWithItsDefaults) {
+  std::string spec = write("spec.json", kSpec);
+  BenchSpec s = read_bench_spec(spec, "");
+  EXPECT_EQ(s.warmup, 0);
+  EXPECT_EQ(s.repeats, 5);
+  EXPECT_EQ(s.check_spp, 1);
+  EXPECT_DOUBLE_EQ(s.check_bound, 0.01);
+  ASSERT_EQ(s.points.size(), 3u);
+  const BenchPoint& p0 = s.points[0];
+  EXPECT_EQ(p0.group, "a");
+  EXPECT_EQ(p0.scene, path("scenes/s.json"));  // relative to the spec's folder
+  EXPECT_EQ(p0.kernels, (std::vector<std::string>{"megakernel", "wavefront"}));
+  EXPECT_EQ(p0.params.width, 64);
+  EXPECT_EQ(p0.params.height, 32);
+  EXPECT_EQ(p0.params.spp, 2);
+  EXPECT_EQ(p0.params.depth, 5);
+  EXPECT_EQ(p0.params.roulette_depth, 5);  // none given: the depth, so no roulette
+  EXPECT_EQ(p0.params.seed, 1u);
+  EXPECT_EQ(s.points[1].params.roulette_depth, 3);
+  EXPECT_EQ(s.points[1].params.seed, 4294967295u);
+  BenchSpec only_b = read_bench_spec(spec, "b");
+  ASSERT_EQ(only_b.points.size(), 1u);
+  EXPECT_EQ(only_b.points[0].kernels, std::vector<std::string>{"wavefront-unsorted"});
+  EXPECT_EQ(error_of([&] { read_bench_spec(spec, "c"); }), spec + ": no points to run in group c");
+}
+
+TEST_F(JobTest, BenchSpecMistakesNameTheirPath) {
+  auto error_with = [&](const std::string& from, const std::string& to) {
+    std::string text = kSpec;
+    size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    std::string spec = write("spec.json", text.replace(at, from.size(), to));
+    return error_of([&] { read_bench_spec(spec, ""); });
+  };
+  const std::string spec = path("spec.json");
+  EXPECT_EQ(error_with("\"roulette_depth\": 3", "\"roulete_depth\": 3"),
+            spec + ": /groups/0/configs/1/roulete_depth: unknown key (expected width, height, spp, depth, "
+                   "roulette_depth, seed)");
+  EXPECT_EQ(error_with("\"wavefront\"]", "\"wavefrnt\"]"),
+            spec + ": /groups/0/kernels/1: unknown value 'wavefrnt' (expected megakernel, megakernel-constant, "
+                   "wavefront, wavefront-unsorted)");
+  EXPECT_EQ(error_with("\"spp\": 4, ", ""), spec + ": /groups/1/configs/0/spp: required key is missing");
+  EXPECT_EQ(error_with("\"spp\": 4", "\"spp\": 0"),
+            spec + ": /groups/1/configs/0/spp: must be an integer in 1..1000000 (got 0)");
+  EXPECT_EQ(error_with("\"repeats\": 5", "\"repeats\": 5, \"repeats\": 6"), spec + ": /repeats: duplicate key");
+  EXPECT_EQ(error_with("\"check_bound\": 0.01", "\"check_bound\": -1"),
+            spec + ": /check_bound: must be a number in [0.0, 1e+30] (got -1)");
+  EXPECT_EQ(error_with("\"width\": 16, \"height\": 16, \"spp\": 4", "\"width\": 16384, \"height\": 16384, \"spp\": 17"),
+            spec + ": /groups/1/configs/0: spp: width x height x spp must stay below 2^32 paths (got 4563402752)");
+  EXPECT_EQ(error_with("\"name\": \"b\", ", ""), spec + ": /groups/1/name: required key is missing");
 }
 
 }  // namespace

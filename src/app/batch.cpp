@@ -5,12 +5,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "queues/wave.hpp"
+#include "render/settings.hpp"
+#include "scene/json_reader.hpp"
 
 namespace wt::app {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
 namespace {
 
@@ -19,40 +19,39 @@ std::string relative_to(const fs::path& base, const std::string& p) {
   return path.is_absolute() ? p : (base / path).lexically_normal().string();
 }
 
-// Applies the fields of one JSON object to a job; throws SceneError naming the field.
-void apply_fields(const json& obj, const std::string& where, const fs::path& base, Job& job) {
-  if (!obj.is_object()) throw SceneError(where + ": must be an object");
-  for (const auto& [key, value] : obj.items()) {
-    const std::string field = where + "/" + key;
-    auto integer = [&](int64_t lo, int64_t hi) {
-      if (!value.is_number_integer() || value.get<int64_t>() < lo || value.get<int64_t>() > hi) {
-        throw SceneError(field + ": must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi));
-      }
-      return static_cast<int>(value.get<int64_t>());
-    };
-    auto text = [&]() {
-      if (!value.is_string()) throw SceneError(field + ": must be a string");
-      return value.get<std::string>();
-    };
-    if (key == "scene") job.scene = relative_to(base, text());
-    else if (key == "output") job.output = relative_to(base, text());
-    else if (key == "stats") job.stats = relative_to(base, text());
-    else if (key == "width") job.width = integer(1, kMaxImageSide);
-    else if (key == "height") job.height = integer(1, kMaxImageSide);
-    else if (key == "spp") job.spp = integer(1, kMaxSpp);
-    else if (key == "depth") job.depth = integer(1, kMaxPathDepth);
-    else if (key == "roulette_depth") job.roulette_depth = integer(0, 1 << 30);
-    else if (key == "seed") job.seed = static_cast<uint32_t>(integer(0, 0x7fffffff));
-    else if (key == "backend") job.backend = text();
-    else if (key == "kernel") job.kernel = text();
-    else if (key == "warmup") job.warmup = integer(0, 100);
-    else if (key == "wave_size") job.wave_size = integer(kMinWaveSlots, static_cast<int64_t>(kMaxWaveSize));
-    else if (key == "encoding") {
-      std::string e = text();
-      if (e != "srgb" && e != "gamma2") throw SceneError(field + ": must be srgb or gamma2");
-      job.encoding = e == "srgb" ? Encoding::Srgb : Encoding::Gamma2;
+// The keys of a job (and of "defaults"): the files, then every setting of the table.
+const std::vector<std::string>& job_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> k = {"scene", "output", "stats", "backend", "kernel", "encoding"};
+    for (const Setting& s : settings()) k.push_back(s.key);
+    return k;
+  }();
+  return keys;
+}
+
+// Applies the fields of one JSON object to a job; throws SceneError naming the file and field.
+void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, const fs::path& base, Job& job) {
+  r.check_keys(obj, path, job_keys());
+  for (auto it = obj.begin(); it != obj.end(); ++it) {
+    const std::string& key = it.key();
+    const json& value = it.value();
+    const JsonPath at = path / key;
+    if (key == "scene") {
+      job.scene = relative_to(base, r.string(value, at));
+    } else if (key == "output") {
+      job.output = relative_to(base, r.string(value, at));
+    } else if (key == "stats") {
+      job.stats = relative_to(base, r.string(value, at));
+    } else if (key == "backend") {
+      job.backend = backend_choices()[r.choice(value, at, backend_choices())];
+    } else if (key == "kernel") {
+      job.kernel = kernel_names()[r.choice(value, at, kernel_names())];
+    } else if (key == "encoding") {
+      job.encoding = r.choice(value, at, encoding_choices()) == 0 ? Encoding::Srgb : Encoding::Gamma2;
     } else {
-      throw SceneError(field + ": unknown key");
+      for (const Setting& s : settings()) {
+        if (key == s.key) set_setting(job, s.id, r.integer(value, at, s.lo, s.hi));
+      }
     }
   }
 }
@@ -67,30 +66,23 @@ bool is_jobs_file(const std::string& path) {
 }
 
 std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base) {
-  std::ifstream f(path);
-  if (!f) throw SceneError(path + ": cannot open jobs file");
-  json doc;
-  try {
-    doc = json::parse(f);
-  } catch (const json::parse_error& e) {
-    throw SceneError(path + ": malformed JSON: " + e.what());
-  }
-  if (!doc.is_object() || !doc.contains("jobs") || !doc["jobs"].is_array()) {
-    throw SceneError(path + ": /jobs: a jobs file needs a \"jobs\" array");
-  }
-  for (const auto& [key, value] : doc.items()) {
-    if (key != "jobs" && key != "defaults") throw SceneError(path + ": /" + key + ": unknown key");
-  }
+  const json doc = read_json_file(path, "jobs file");
+  const JsonReader r(path);
+  const JsonPath top;
+  r.check_keys(doc, top, {"jobs", "defaults"});
+  const JsonPath jobs_path = top / "jobs";
+  const json& list = r.array(r.required(doc, top, "jobs"), jobs_path);
   const fs::path folder = fs::path(path).parent_path();
   Job defaults = base;
-  if (doc.contains("defaults")) apply_fields(doc["defaults"], path + ": /defaults", folder, defaults);
+  if (doc.contains("defaults")) apply_fields(r, doc["defaults"], top / "defaults", folder, defaults);
   std::vector<PlannedJob> jobs;
-  for (size_t i = 0; i < doc["jobs"].size(); ++i) {
+  for (size_t i = 0; i < list.size(); ++i) {
     PlannedJob planned{defaults, ""};
+    const JsonPath at = jobs_path / i;
     try {
-      apply_fields(doc["jobs"][i], path + ": /jobs/" + std::to_string(i), folder, planned.job);
-      if (planned.job.scene.empty()) throw SceneError(path + ": /jobs/" + std::to_string(i) + ": needs a scene");
-      if (planned.job.output.empty()) throw SceneError(path + ": /jobs/" + std::to_string(i) + ": needs an output");
+      apply_fields(r, list[i], at, folder, planned.job);
+      if (planned.job.scene.empty()) r.fail_at(at / "scene", "required key is missing (in the job or its defaults)");
+      if (planned.job.output.empty()) r.fail_at(at / "output", "required key is missing (in the job or its defaults)");
     } catch (const SceneError& e) {
       planned.error = e.what();
     }

@@ -11,74 +11,74 @@
 #include <sstream>
 
 #include "app/job.hpp"
+#include "app/stats.hpp"
 #include "build_info.hpp"
 #include "cuda/device.hpp"
-
+#include "render/settings.hpp"
+#include "scene/json_reader.hpp"
 
 namespace wt::app {
 
 namespace fs = std::filesystem;
-using nlohmann::json;
 
-namespace {
+BenchSpec read_bench_spec(const std::string& path, const std::string& only) {
+  const json doc = read_json_file(path, "bench spec");
+  const JsonReader r(path);
+  const JsonPath top;
+  r.check_keys(doc, top, {"warmup", "repeats", "check_spp", "check_bound", "groups"});
+  BenchSpec spec;
+  const Setting& warmup = setting(SettingId::Warmup);
+  if (doc.contains("warmup")) spec.warmup = static_cast<int>(r.integer(doc["warmup"], top / "warmup", warmup.lo, warmup.hi));
+  if (doc.contains("repeats")) spec.repeats = static_cast<int>(r.integer(doc["repeats"], top / "repeats", 1, kMaxRepeats));
+  if (doc.contains("check_spp")) spec.check_spp = static_cast<int>(r.integer(doc["check_spp"], top / "check_spp", 1, kMaxSpp));
+  if (doc.contains("check_bound")) spec.check_bound = r.real(doc["check_bound"], top / "check_bound", 0.0, 1e30);
 
-struct Point {
-  std::string group, scene;
-  RenderParams params{};
-  std::vector<std::string> kernels;
-};
-
-struct Spec {
-  int warmup = 1, repeats = 3, check_spp = 2;
-  double check_bound = 3e-3;
-  std::vector<Point> points;
-};
-
-template <class T>
-T field(const json& j, const char* key, const std::string& where) {
-  if (!j.contains(key)) throw SceneError(where + "/" + key + ": missing");
-  try {
-    return j.at(key).get<T>();
-  } catch (const json::exception&) {
-    throw SceneError(where + "/" + key + ": wrong type");
-  }
-}
-
-Spec read_spec(const std::string& path, const std::string& only) {
-  std::ifstream f(path);
-  if (!f) throw SceneError(path + ": cannot open bench spec");
-  json doc = json::parse(f, nullptr, false);
-  if (doc.is_discarded() || !doc.is_object()) throw SceneError(path + ": malformed JSON");
-  Spec spec;
-  spec.warmup = doc.value("warmup", spec.warmup);
-  spec.repeats = doc.value("repeats", spec.repeats);
-  spec.check_spp = doc.value("check_spp", spec.check_spp);
-  spec.check_bound = doc.value("check_bound", spec.check_bound);
   const fs::path folder = fs::path(path).parent_path();
-  const json groups = doc.value("groups", json::array());
+  const JsonPath groups_path = top / "groups";
+  const json& groups = r.array(r.required(doc, top, "groups"), groups_path);
+  std::vector<std::string> config_keys;
+  for (SettingId id : render_settings()) config_keys.push_back(setting(id).key);
   for (size_t g = 0; g < groups.size(); ++g) {
-    const std::string where = path + ": /groups/" + std::to_string(g);
-    const std::string name = field<std::string>(groups[g], "name", where);
-    if (!only.empty() && name != only) continue;
-    const std::string scene = (folder / field<std::string>(groups[g], "scene", where)).lexically_normal().string();
-    const auto kernels = field<std::vector<std::string>>(groups[g], "kernels", where);
-    for (const std::string& k : kernels) parse_kernel(k);
-    const json configs = field<json>(groups[g], "configs", where);
-    for (const json& c : configs) {
-      Point p{name, scene, {}, kernels};
-      p.params.width = field<int>(c, "width", where);
-      p.params.height = field<int>(c, "height", where);
-      p.params.spp = field<int>(c, "spp", where);
-      p.params.depth = field<int>(c, "depth", where);
-      p.params.roulette_depth = c.value("roulette_depth", p.params.depth);
-      p.params.seed = c.value("seed", 1u);
-      validate_params(p.params);
-      spec.points.push_back(p);
+    const JsonPath gp = groups_path / g;
+    r.check_keys(groups[g], gp, {"name", "scene", "kernels", "configs"});
+    const std::string& name = r.string(r.required(groups[g], gp, "name"), gp / "name");
+    const std::string scene =
+        (folder / r.string(r.required(groups[g], gp, "scene"), gp / "scene")).lexically_normal().string();
+    const JsonPath kp = gp / "kernels";
+    const json& kernel_list = r.array(r.required(groups[g], gp, "kernels"), kp);
+    if (kernel_list.empty()) r.fail_at(kp, "must name at least one kernel");
+    std::vector<std::string> kernels;
+    for (size_t k = 0; k < kernel_list.size(); ++k) kernels.push_back(kernel_names()[r.choice(kernel_list[k], kp / k, kernel_names())]);
+    const JsonPath cp = gp / "configs";
+    const json& configs = r.array(r.required(groups[g], gp, "configs"), cp);
+    for (size_t c = 0; c < configs.size(); ++c) {
+      const JsonPath at = cp / c;
+      r.check_keys(configs[c], at, config_keys);
+      BenchPoint p{name, scene, RenderDefaults(), kernels};
+      p.params.roulette_depth = -1;  // none given: equal to depth (no roulette)
+      for (SettingId id : render_settings()) {
+        const Setting& s = setting(id);
+        const bool needed = id == SettingId::Width || id == SettingId::Height || id == SettingId::Spp ||
+                            id == SettingId::Depth;
+        if (needed || configs[c].contains(s.key)) {
+          set_param(p.params, id, r.integer(needed ? r.required(configs[c], at, s.key) : configs[c][s.key],
+                                            at / s.key, s.lo, s.hi));
+        }
+      }
+      if (p.params.roulette_depth < 0) p.params.roulette_depth = p.params.depth;
+      try {
+        validate_params(p.params);
+      } catch (const SceneError& e) {
+        r.fail_at(at, e.what());
+      }
+      if (only.empty() || name == only) spec.points.push_back(p);
     }
   }
   if (spec.points.empty()) throw SceneError(path + ": no points to run" + (only.empty() ? "" : " in group " + only));
   return spec;
 }
+
+namespace {
 
 double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
   double s = 0;
@@ -119,7 +119,7 @@ std::string utc_now() {
 }  // namespace
 
 int run_bench(const BenchOptions& options) {
-  Spec spec = read_spec(options.spec, options.only);
+  BenchSpec spec = read_bench_spec(options.spec, options.only);
   if (options.repeats > 0) spec.repeats = options.repeats;
   const Backend backend = parse_backend(options.backend);
   std::error_code ec;
@@ -135,12 +135,14 @@ int run_bench(const BenchOptions& options) {
   results["warmup"] = spec.warmup;
   results["repeats"] = spec.repeats;
   results["check"] = {{"spp", spec.check_spp}, {"max_mean_abs_diff", spec.check_bound}, {"against", "megakernel"}};
+  results["kernels"] = kernel_names();
   results["points"] = json::array();
+  std::vector<std::string> stages;  // the wavefront's stages, in the order they run
 
   size_t total = 0, done = 0;
-  for (const Point& p : spec.points) total += p.kernels.size();
+  for (const BenchPoint& p : spec.points) total += p.kernels.size();
   int failures = 0;
-  for (const Point& p : spec.points) {
+  for (const BenchPoint& p : spec.points) {
     Scene scene = load_scene(p.scene);
     // The reference image for the check: the megakernel at the check's sample count.
     RenderOptions check;
@@ -151,9 +153,10 @@ int run_bench(const BenchOptions& options) {
     const RenderResult reference = render(scene, check);
     for (const std::string& kname : p.kernels) {
       ++done;
-      json row = {{"group", p.group},         {"scene", p.scene},       {"width", p.params.width},
-                  {"height", p.params.height}, {"spp", p.params.spp},    {"depth", p.params.depth},
-                  {"roulette_depth", p.params.roulette_depth},           {"kernel", kname}};
+      json row = settings_json(p.params);
+      row["group"] = p.group;
+      row["scene"] = p.scene;
+      row["kernel"] = kname;
       std::fprintf(stderr, "[%zu/%zu] %s %s %dx%d %d spp depth %d %s\n", done, total, p.group.c_str(),
                    fs::path(p.scene).filename().c_str(), p.params.width, p.params.height, p.params.spp,
                    p.params.depth, kname.c_str());
@@ -194,17 +197,9 @@ int run_bench(const BenchOptions& options) {
         row["seconds_median"] = med;
         row["seconds_min"] = *std::min_element(seconds.begin(), seconds.end());
         row["seconds_max"] = *std::max_element(seconds.begin(), seconds.end());
-        row["upload_seconds"] = kept.upload_seconds;
-        row["rays"] = kept.rays;
-        row["paths"] = kept.paths;
-        row["rays_per_path"] = static_cast<double>(kept.rays) / kept.paths;
-        row["m_rays_per_s"] = kept.rays / med / 1e6;
-        row["m_paths_per_s"] = kept.paths / med / 1e6;
-        if (!kept.stages.empty()) {
-          json stages = json::object();
-          for (const StageTime& s : kept.stages) stages[s.name] = s.ms;
-          row["stage_ms"] = stages;
-          row["live_per_bounce"] = kept.live_per_bounce;
+        add_measurements(row, kept, med, scene.load_times);
+        for (const StageTime& st : kept.stages) {
+          if (std::find(stages.begin(), stages.end(), st.name) == stages.end()) stages.push_back(st.name);
         }
         std::fprintf(stderr, "    median %.3f s, %.1f M rays/s, %.1f M paths/s, check diff %.2e\n", med,
                      kept.rays / med / 1e6, kept.paths / med / 1e6, diff);
@@ -216,6 +211,8 @@ int run_bench(const BenchOptions& options) {
       results["points"].push_back(row);
     }
   }
+
+  results["stages"] = stages;
 
   std::ostringstream csv;
   csv << "group,scene,width,height,spp,depth,kernel,status,seconds_median,seconds_min,seconds_max,rays,paths,"

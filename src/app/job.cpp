@@ -20,30 +20,54 @@ Backend parse_backend(const std::string& name) {
   throw SceneError("backend: unknown backend '" + name + "' (expected cuda, cpu or auto)");
 }
 
-Kernel parse_kernel(const std::string& name) {
-  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
-    if (name == kernel_name(k)) return k;
+namespace {
+
+// The job's field for a render setting (const or not, as the job); null for the others.
+template <class J>
+auto render_override(J& job, SettingId id) -> decltype(&job.width) {
+  switch (id) {
+    case SettingId::Width: return &job.width;
+    case SettingId::Height: return &job.height;
+    case SettingId::Spp: return &job.spp;
+    case SettingId::Depth: return &job.depth;
+    case SettingId::RouletteDepth: return &job.roulette_depth;
+    case SettingId::Seed: return &job.seed;
+    default: return nullptr;
   }
-  throw SceneError("kernel: unknown kernel '" + name +
-                   "' (expected megakernel, megakernel-constant, wavefront or wavefront-unsorted)");
+}
+
+}  // namespace
+
+void set_setting(Job& job, SettingId id, int64_t value) {
+  if (std::optional<int64_t>* o = render_override(job, id)) {
+    *o = value;
+  } else if (id == SettingId::Warmup) {
+    job.warmup = value;
+  } else if (id == SettingId::WaveSize) {
+    job.wave_size = value;
+  } else if (id == SettingId::Threads) {
+    job.threads = value;
+  }
 }
 
 namespace {
 
 RenderParams resolve_params(const Scene& scene, const Job& job) {
   RenderParams p = default_params(scene);
-  if (job.width) p.width = *job.width;
-  if (job.height) p.height = *job.height;
-  if (job.spp) p.spp = *job.spp;
-  if (job.depth) p.depth = *job.depth;
-  if (job.roulette_depth) p.roulette_depth = *job.roulette_depth;
-  if (job.seed) p.seed = *job.seed;
+  for (SettingId id : render_settings()) {
+    if (const std::optional<int64_t>& v = *render_override(job, id)) set_param(p, id, *v);
+  }
   try {
     validate_params(p);
   } catch (const SceneError& e) {
     throw SceneError(job.scene + ": settings: " + e.what());
   }
   return p;
+}
+
+void print_load_times(const LoadTimes& t, double upload_seconds) {
+  std::fprintf(stderr, "load: parse %.3f s, validate %.3f s, texture load %.3f s, BVH build %.3f s, upload %.3f s\n",
+               t.parse, t.validate, t.texture_load, t.bvh_build, upload_seconds);
 }
 
 void print_profile(const RenderResult& r) {
@@ -69,13 +93,14 @@ JobOutcome run_job(const Job& job) {
     check_output_path(job.output);
     if (!job.stats.empty()) check_output_path_for_text(job.stats);
     Scene scene = load_scene(job.scene);
+    out.load_times = scene.load_times;
     RenderOptions options;
     options.params = resolve_params(scene, job);
     options.kernel = parse_kernel(job.kernel);
     options.backend = parse_backend(job.backend);
-    options.warmup = job.warmup;
+    options.warmup = static_cast<int>(job.warmup);
     options.wave_size = job.wave_size;
-    options.threads = job.threads;
+    options.threads = static_cast<int>(job.threads);
     out.params = options.params;
     out.backend = backend_name(options.backend);
     out.kernel = kernel_name(options.kernel);
@@ -88,7 +113,10 @@ JobOutcome run_job(const Job& job) {
     }
     write_image(job.output, options.params.width, options.params.height, out.result.rgb, job.encoding);
     if (!job.stats.empty()) write_text_file(job.stats, stats_json(job, out).dump(2) + "\n");
-    if (job.profile) print_profile(out.result);
+    if (job.profile) {
+      print_load_times(out.load_times, out.result.upload_seconds);
+      print_profile(out.result);
+    }
   } catch (const SceneError& e) {
     out.exit_code = kExitBadInput;
     out.message = e.what();

@@ -8,6 +8,7 @@
 
 #include "image/image_io.hpp"
 #include "render/renderer.hpp"
+#include "render/settings.hpp"
 
 namespace wt::app {
 
@@ -15,13 +16,13 @@ struct Job {
   std::string scene;
   std::string output;
   std::string stats;  // empty: no stats file
-  std::optional<int> width, height, spp, depth, roulette_depth;
-  std::optional<uint32_t> seed;
+  // The render settings (src/render/settings.hpp); unset: the scene's.
+  std::optional<int64_t> width, height, spp, depth, roulette_depth, seed;
   std::string backend = "auto";
   std::string kernel = "megakernel";
-  int warmup = 0;
-  int64_t wave_size = 0;
-  int threads = 0;
+  int64_t warmup = 0;
+  int64_t wave_size = 0;  // 0: chosen at run time
+  int64_t threads = 0;    // 0: every core
   Encoding encoding = Encoding::Srgb;
   bool progress = true;
   bool profile = false;
@@ -35,6 +36,7 @@ struct JobOutcome {
   int exit_code = 0;
   std::string message;  // the one line that says why, when exit_code != 0
   RenderParams params{};
+  LoadTimes load_times;
   std::string backend, kernel;
   RenderResult result;
 };
@@ -42,7 +44,9 @@ struct JobOutcome {
 // Runs a job; never throws. Writes the image (and stats) only when the render succeeded.
 JobOutcome run_job(const Job& job);
 
+// Sets a setting of the table (already checked against its range).
+void set_setting(Job& job, SettingId id, int64_t value);
+
 Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
-Kernel parse_kernel(const std::string& name);    // throws SceneError
 
 }  // namespace wt::app

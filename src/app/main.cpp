@@ -6,32 +6,28 @@
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
-#include "queues/wave.hpp"
+#include "render/settings.hpp"
+#include "scene/json_reader.hpp"
 
 namespace {
 
 using wt::app::Job;
 
-// The options that render and batch share; they fill `job`.
+// The options that render and batch share; they fill `job`. Names, ranges and help
+// of the numeric settings come from the settings table.
 void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
-  cmd.add_option("--width", job.width, "image width in pixels")->check(CLI::Range(1, wt::kMaxImageSide));
-  cmd.add_option("--height", job.height, "image height in pixels")->check(CLI::Range(1, wt::kMaxImageSide));
-  cmd.add_option("--spp", job.spp, "samples per pixel")->check(CLI::Range(1, wt::kMaxSpp));
-  cmd.add_option("--depth", job.depth, "most rays per path")->check(CLI::Range(1, wt::kMaxPathDepth));
-  cmd.add_option("--roulette-depth", job.roulette_depth, "Russian roulette from this many bounces on")
-      ->check(CLI::Range(0, 1 << 30));
-  cmd.add_option("--seed", job.seed, "render seed");
+  for (const wt::Setting& s : wt::settings()) {
+    cmd.add_option_function<int64_t>(
+           s.flag, [&job, id = s.id](int64_t v) { wt::app::set_setting(job, id, v); }, s.help)
+        ->check(CLI::Range(s.lo, s.hi));
+  }
   cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
-      ->check(CLI::IsMember({"cuda", "cpu", "auto"}));
-  cmd.add_option("--kernel", job.kernel, "megakernel, megakernel-constant, wavefront or wavefront-unsorted")
-      ->check(CLI::IsMember({"megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"}));
-  cmd.add_option("--warmup", job.warmup, "untimed renders before the timed one")->check(CLI::Range(0, 100));
-  cmd.add_option("--wave-size", job.wave_size, "wavefront path slots (default: chosen from free memory)")
-      ->check(CLI::Range(wt::kMinWaveSlots, static_cast<int64_t>(wt::kMaxWaveSize)));
-  cmd.add_option("--threads", job.threads, "CPU threads (default: all cores)")->check(CLI::Range(1, 1024));
+      ->check(CLI::IsMember(wt::backend_choices()));
+  cmd.add_option("--kernel", job.kernel, "the kernel: " + wt::listed(wt::kernel_names()))
+      ->check(CLI::IsMember(wt::kernel_names()));
   cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
-      ->check(CLI::IsMember({"srgb", "gamma2"}));
-  cmd.add_flag("--profile", job.profile, "print the wavefront's per-stage times");
+      ->check(CLI::IsMember(wt::encoding_choices()));
+  cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
 }
 
 void set_encoding(Job& job, const std::string& encoding) {
@@ -67,11 +63,17 @@ int main(int argc, char** argv) {
   CLI::App* bench = app.add_subcommand("bench", "time a grid of scenes x configurations x kernels");
   bench->add_option("spec", bench_options.spec, "bench spec (JSON), e.g. bench/study.json")->required();
   bench->add_option("-o,--output-dir", bench_options.out_dir, "folder for results.json and results.csv")->required();
-  bench->add_option("--backend", bench_options.backend, "cuda, cpu or auto")->check(CLI::IsMember({"cuda", "cpu", "auto"}));
+  bench->add_option("--backend", bench_options.backend, "cuda, cpu or auto")
+      ->check(CLI::IsMember(wt::backend_choices()));
   bench->add_option("--only", bench_options.only, "run one group of the spec");
   bench->add_option("--repeats", bench_options.repeats, "timed runs per point (default: the spec's)")
-      ->check(CLI::Range(1, 100));
+      ->check(CLI::Range(1, wt::app::kMaxRepeats));
   bench->add_option("--commit", bench_options.commit, "the commit being measured, recorded in the results");
+
+  std::string kernels_backend;
+  CLI::App* kernels = app.add_subcommand("kernels", "list the kernels, one a line, in the order the docs use");
+  kernels->add_option("--backend", kernels_backend, "only those that run on this backend: cuda or cpu")
+      ->check(CLI::IsMember({"cuda", "cpu"}));
 
   try {
     app.parse(argc, argv);
@@ -93,6 +95,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
                  o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
                  static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);
+    return 0;
+  }
+
+  if (*kernels) {
+    const std::vector<std::string> names =
+        kernels_backend.empty() ? wt::kernel_names()
+                                : wt::kernel_names(kernels_backend == "cuda" ? wt::Backend::Cuda : wt::Backend::Cpu);
+    for (const std::string& name : names) std::printf("%s\n", name.c_str());
     return 0;
   }
 

@@ -11,25 +11,23 @@ void check_output_path_for_text(const std::string& path) {
   check_output_folder(path);
 }
 
-nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
-  const RenderResult& r = o.result;
-  nlohmann::json j;
-  j["scene"] = job.scene;
-  j["output"] = job.output;
-  j["settings"] = {{"width", o.params.width},   {"height", o.params.height},
-                   {"spp", o.params.spp},       {"depth", o.params.depth},
-                   {"roulette_depth", o.params.roulette_depth}, {"seed", o.params.seed},
-                   {"warmup", job.warmup},      {"wave_size", job.wave_size}};
-  j["backend"] = o.backend;
-  j["kernel"] = o.kernel;
-  j["device"] = r.device;
+nlohmann::json settings_json(const RenderParams& params) {
+  nlohmann::json j = nlohmann::json::object();
+  for (SettingId id : render_settings()) j[setting(id).key] = get_param(params, id);
+  return j;
+}
+
+void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load) {
   j["rays"] = r.rays;
   j["paths"] = r.paths;
-  j["seconds"] = r.seconds;
-  j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
   j["upload_seconds"] = r.upload_seconds;
-  j["m_rays_per_s"] = r.seconds > 0 ? r.rays / r.seconds / 1e6 : 0.0;
-  j["m_paths_per_s"] = r.seconds > 0 ? r.paths / r.seconds / 1e6 : 0.0;
+  j["load_seconds"] = {{"parse", load.parse},
+                       {"validate", load.validate},
+                       {"texture_load", load.texture_load},
+                       {"bvh_build", load.bvh_build},
+                       {"upload", r.upload_seconds}};
+  j["m_rays_per_s"] = seconds > 0 ? r.rays / seconds / 1e6 : 0.0;
+  j["m_paths_per_s"] = seconds > 0 ? r.paths / seconds / 1e6 : 0.0;
   j["rays_per_path"] = r.paths ? static_cast<double>(r.rays) / r.paths : 0.0;
   if (!r.stages.empty()) {
     nlohmann::json stages = nlohmann::json::object();
@@ -37,6 +35,22 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
     j["stage_ms"] = stages;
     j["live_per_bounce"] = r.live_per_bounce;
   }
+}
+
+nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
+  const RenderResult& r = o.result;
+  nlohmann::json j;
+  j["scene"] = job.scene;
+  j["output"] = job.output;
+  j["settings"] = settings_json(o.params);
+  j["settings"][setting(SettingId::Warmup).key] = job.warmup;
+  j["settings"][setting(SettingId::WaveSize).key] = job.wave_size;
+  j["backend"] = o.backend;
+  j["kernel"] = o.kernel;
+  j["device"] = r.device;
+  j["seconds"] = r.seconds;
+  j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
+  add_measurements(j, r, r.seconds, o.load_times);
   return j;
 }
 

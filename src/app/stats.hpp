@@ -1,4 +1,5 @@
-// The --stats file: what was rendered, where, and how fast.
+// The statistics of a render, one writer for `render --stats` and bench's rows:
+// what was rendered, and how fast.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -7,6 +8,15 @@
 
 namespace wt::app {
 
+// The render settings by their keys in the settings table.
+nlohmann::json settings_json(const RenderParams& params);
+
+// Adds what a render measured to `j`: counts, rates over `seconds` (the render's
+// time, or a median of several), upload and load phase times, and for the wavefront
+// the stage times and live paths per bounce.
+void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load);
+
+// The --stats file of one job.
 nlohmann::json stats_json(const Job& job, const JobOutcome& outcome);
 
 // Like check_output_path, for a JSON file.

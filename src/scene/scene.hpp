@@ -21,18 +21,28 @@ struct Image {
 };
 
 // The sane limits of a render's settings, wherever they are given (scene file,
-// command line, jobs file).
+// command line, jobs file, bench spec). src/render/settings.cpp gathers them, with
+// the defaults below, into the one table of settings that every reader checks against.
 constexpr int kMaxImageSide = 16384;
 constexpr int kMaxSpp = 1000000;
 constexpr int kMaxPathDepth = 1024;
 
-struct RenderDefaults {
-  int width = 640;
-  int height = 360;
-  int spp = 16;
-  int depth = 10;
-  int roulette_depth = 5;
-  uint32_t seed = 1;
+// Russian roulette starts at the latest after this many bounces (a path never gets
+// near it: depth is at most kMaxPathDepth).
+constexpr int kMaxRouletteDepth = 1 << 30;
+
+// A scene's render settings: the defaults below unless its `render` section says otherwise.
+struct RenderDefaults : RenderParams {
+  RenderDefaults() : RenderParams{640, 360, 16, 10, 5, 1} {}
+};
+
+// How long each host-side phase of loading a scene took, in seconds (wall clock).
+// Uploading to the device is timed by the backend (RenderResult::upload_seconds).
+struct LoadTimes {
+  double parse = 0;         // reading the file and parsing the JSON
+  double validate = 0;      // checking every field and building the scene's arrays
+  double texture_load = 0;  // decoding image textures (not part of validate)
+  double bvh_build = 0;
 };
 
 struct Scene {
@@ -47,6 +57,7 @@ struct Scene {
   std::vector<SphereGeom> spheres;          // in BVH order once built
   std::vector<uint32_t> sphere_material;    // per sphere, in BVH order
   std::vector<BvhNode> nodes;
+  LoadTimes load_times;
 
   // Number of low bits that hold every sort key the scene's materials use (at least 1).
   int sort_key_bits() const;

@@ -1,0 +1,109 @@
+#include "render/settings.hpp"
+
+#include "queues/wave.hpp"
+#include "scene/json_reader.hpp"
+
+namespace wt {
+
+const std::vector<Setting>& settings() {
+  static const RenderDefaults d;
+  static const std::vector<Setting> table = {
+      {SettingId::Width, "width", "--width", SettingType::Int32, 1, kMaxImageSide, d.width, "image width in pixels"},
+      {SettingId::Height, "height", "--height", SettingType::Int32, 1, kMaxImageSide, d.height,
+       "image height in pixels"},
+      {SettingId::Spp, "spp", "--spp", SettingType::Int32, 1, kMaxSpp, d.spp, "samples per pixel"},
+      {SettingId::Depth, "depth", "--depth", SettingType::Int32, 1, kMaxPathDepth, d.depth, "most rays per path"},
+      {SettingId::RouletteDepth, "roulette_depth", "--roulette-depth", SettingType::Int32, 0, kMaxRouletteDepth,
+       d.roulette_depth, "Russian roulette from this many bounces on"},
+      {SettingId::Seed, "seed", "--seed", SettingType::UInt32, 0, UINT32_MAX, d.seed, "render seed"},
+      {SettingId::Warmup, "warmup", "--warmup", SettingType::Int32, 0, 100, 0, "untimed renders before the timed one"},
+      {SettingId::WaveSize, "wave_size", "--wave-size", SettingType::Int64, kMinWaveSlots,
+       static_cast<int64_t>(kMaxWaveSize), 0, "wavefront path slots (default: chosen from free memory)"},
+      {SettingId::Threads, "threads", "--threads", SettingType::Int32, 1, 1024, 0, "CPU threads (default: all cores)"},
+  };
+  return table;
+}
+
+const Setting& setting(SettingId id) { return settings()[static_cast<size_t>(id)]; }
+
+const std::vector<SettingId>& render_settings() {
+  static const std::vector<SettingId> ids = {SettingId::Width, SettingId::Height,        SettingId::Spp,
+                                             SettingId::Depth, SettingId::RouletteDepth, SettingId::Seed};
+  return ids;
+}
+
+int64_t get_param(const RenderParams& p, SettingId id) {
+  switch (id) {
+    case SettingId::Width: return p.width;
+    case SettingId::Height: return p.height;
+    case SettingId::Spp: return p.spp;
+    case SettingId::Depth: return p.depth;
+    case SettingId::RouletteDepth: return p.roulette_depth;
+    case SettingId::Seed: return p.seed;
+    default: throw std::logic_error(std::string("not a render parameter: ") + setting(id).key);
+  }
+}
+
+void set_param(RenderParams& p, SettingId id, int64_t value) {
+  switch (id) {
+    case SettingId::Width: p.width = static_cast<int32_t>(value); break;
+    case SettingId::Height: p.height = static_cast<int32_t>(value); break;
+    case SettingId::Spp: p.spp = static_cast<int32_t>(value); break;
+    case SettingId::Depth: p.depth = static_cast<int32_t>(value); break;
+    case SettingId::RouletteDepth: p.roulette_depth = static_cast<int32_t>(value); break;
+    case SettingId::Seed: p.seed = static_cast<uint32_t>(value); break;
+    default: throw std::logic_error(std::string("not a render parameter: ") + setting(id).key);
+  }
+}
+
+void check_setting(SettingId id, int64_t value) {
+  const Setting& s = setting(id);
+  if (value < s.lo || value > s.hi) {
+    throw SceneError(std::string(s.key) + ": must be in " + std::to_string(s.lo) + ".." + std::to_string(s.hi) +
+                     " (got " + std::to_string(value) + ")");
+  }
+}
+
+const std::vector<Kernel>& kernels() {
+  static const std::vector<Kernel> all = {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront,
+                                          Kernel::WavefrontUnsorted};
+  return all;
+}
+
+// The constant-memory megakernel needs CUDA's __constant__ memory.
+bool kernel_runs_on(Kernel kernel, Backend backend) {
+  return backend == Backend::Cuda || kernel != Kernel::MegakernelConstant;
+}
+
+std::vector<std::string> kernel_names() {
+  std::vector<std::string> names;
+  for (Kernel k : kernels()) names.push_back(kernel_name(k));
+  return names;
+}
+
+std::vector<std::string> kernel_names(Backend backend) {
+  std::vector<std::string> names;
+  for (Kernel k : kernels()) {
+    if (kernel_runs_on(k, backend)) names.push_back(kernel_name(k));
+  }
+  return names;
+}
+
+Kernel parse_kernel(const std::string& name) {
+  for (Kernel k : kernels()) {
+    if (name == kernel_name(k)) return k;
+  }
+  throw SceneError("kernel: unknown kernel '" + name + "' (expected " + listed(kernel_names()) + ")");
+}
+
+const std::vector<std::string>& backend_choices() {
+  static const std::vector<std::string> names = {"cuda", "cpu", "auto"};
+  return names;
+}
+
+const std::vector<std::string>& encoding_choices() {
+  static const std::vector<std::string> names = {"srgb", "gamma2"};
+  return names;
+}
+
+}  // namespace wt

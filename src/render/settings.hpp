@@ -1,0 +1,54 @@
+// The one table of a render's settings: name, type, inclusive range and default.
+// The command line, a scene's `render` section, jobs files, bench specs,
+// validate_params and the stats writer all read it, so a setting has one range
+// wherever it is given.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/renderer.hpp"
+
+namespace wt {
+
+enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Warmup, WaveSize, Threads };
+
+enum class SettingType { Int32, UInt32, Int64 };
+
+struct Setting {
+  SettingId id;
+  const char* key;   // in JSON (scene `render` sections, jobs files, bench configs, stats)
+  const char* flag;  // on the command line
+  SettingType type;
+  int64_t lo, hi;    // the inclusive range of a value that is given
+  int64_t fallback;  // the default; 0 for wave_size and threads: chosen at run time
+  const char* help;
+};
+
+// Every setting, in the order above.
+const std::vector<Setting>& settings();
+const Setting& setting(SettingId id);
+
+// The settings a RenderParams holds (width .. seed): a scene's `render` section
+// and a bench configuration give these.
+const std::vector<SettingId>& render_settings();
+int64_t get_param(const RenderParams& p, SettingId id);
+void set_param(RenderParams& p, SettingId id, int64_t value);
+
+// Throws SceneError "<key>: must be in lo..hi (got value)" when value is out of range.
+void check_setting(SettingId id, int64_t value);
+
+// The kernels, in the order the docs and plots list them, and the backends each runs on.
+const std::vector<Kernel>& kernels();
+bool kernel_runs_on(Kernel kernel, Backend backend);
+std::vector<std::string> kernel_names();
+std::vector<std::string> kernel_names(Backend backend);
+Kernel parse_kernel(const std::string& name);  // throws SceneError naming the kernels
+
+// The names a backend may be asked for ("auto": CUDA when a device is present), and
+// the PNG encodings.
+const std::vector<std::string>& backend_choices();
+const std::vector<std::string>& encoding_choices();
+
+}  // namespace wt
