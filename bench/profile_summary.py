@@ -8,11 +8,12 @@ same numbers go to profiles.json for plots and tables.
 """
 import argparse
 import csv
+import glob
 import json
 import os
+import re
 
 SCENES = ["seed57", "divergent"]
-KERNELS = ["megakernel", "megakernel-constant", "wavefront", "wavefront-unsorted"]
 COLUMNS = {
     "registers": "launch__registers_per_thread",
     "occupancy_pct": "sm__warps_active.avg.pct_of_peak_sustained_active",
@@ -38,7 +39,11 @@ def read_profile(path):
     out = []
     for row in data:
         rec = dict(zip(header, row))
-        name = rec["Kernel Name"].split("(")[0].split("::")[-1]
+        function = rec["Kernel Name"].split("(")[0]
+        # A wavefront stage runs as the generic stage kernel over its item type:
+        # "for_each_kernel<wt::ShadeItem>" is the shade stage.
+        stage = re.search(r"<(?:\w+::)*(\w+)Item>", function)
+        name = stage.group(1).lower() if stage else function.split("::")[-1]
         item = {"launch": name}
         for key, column in COLUMNS.items():
             item[key] = number(rec[column]) if column in rec else float("nan")
@@ -53,10 +58,9 @@ def main():
     args = ap.parse_args()
     profiles = {}
     for scene in SCENES:
-        for k in KERNELS:
-            path = os.path.join(args.results, "profile-%s-%s.csv" % (scene, k))
-            if os.path.exists(path):
-                profiles.setdefault(scene, {})[k] = read_profile(path)
+        prefix = os.path.join(args.results, "profile-%s-" % scene)
+        for path in sorted(glob.glob(prefix + "*.csv")):
+            profiles.setdefault(scene, {})[path[len(prefix):-len(".csv")]] = read_profile(path)
     lines = [
         "| scene | kernel | launch | registers / thread | achieved occupancy | warp execution efficiency "
         "| DRAM throughput | memory throughput | duration |",

@@ -14,17 +14,19 @@ metrics=launch__registers_per_thread,sm__warps_active.avg.pct_of_peak_sustained_
 
 # profile LABEL WAVEFRONT_SKIP SCENE ARGS...: each kernel's profile into profile-LABEL-KERNEL.csv.
 # The megakernels' first launch is profiled; the wavefront's intersect and shade
-# after WAVEFRONT_SKIP launches, in the steady state with the wave full.
+# (the generic stage kernel over IntersectItem and ShadeItem) after WAVEFRONT_SKIP
+# launches, in the steady state with the wave full.
 profile() {
   local label=$1 skip=$2
   shift 2
-  for kernel in megakernel megakernel-constant wavefront wavefront-unsorted; do
-    local filter="regex:intersect_kernel|shade_kernel" from=$skip count=4
+  for kernel in $("$bin/wavetrace" kernels --backend cuda); do
+    local filter="regex:IntersectItem|ShadeItem" from=$skip count=4
     case $kernel in
       megakernel) filter="regex:megakernel_global" from=0 count=1 ;;
       megakernel-constant) filter="regex:megakernel_constant" from=0 count=1 ;;
     esac
-    ncu --clock-control none --metrics "$metrics" -k "$filter" --launch-skip "$from" --launch-count "$count" \
+    ncu --clock-control none --metrics "$metrics" --kernel-name-base demangled -k "$filter" \
+      --launch-skip "$from" --launch-count "$count" \
       --csv --page raw "$bin/wavetrace" render "$@" -o "$out/profile.png" --backend cuda -q --kernel "$kernel" \
       >"$out/profile-$label-$kernel.csv" || echo "profile of $kernel on $label failed"
   done

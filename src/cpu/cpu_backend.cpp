@@ -7,6 +7,7 @@
 
 #include "cpu/cpu_wavefront.hpp"
 #include "cpu/parallel.hpp"
+#include "render/settings.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt::cpu {
@@ -60,8 +61,9 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const RenderParams& rp = options.params;
-  if (options.kernel == Kernel::MegakernelConstant) {
-    throw SceneError("kernel: megakernel-constant needs the cuda backend (constant memory is a GPU memory)");
+  if (!kernel_runs_on(options.kernel, Backend::Cpu)) {
+    throw SceneError(std::string("kernel: ") + kernel_name(options.kernel) +
+                     " needs the cuda backend (constant memory is a GPU memory)");
   }
   std::vector<ImageView> images;
   const SceneView view = host_view(scene, rp.width, rp.height, images);

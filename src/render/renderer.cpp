@@ -10,15 +10,6 @@ namespace wt {
 
 const char* backend_name(Backend b) { return b == Backend::Cuda ? "cuda" : "cpu"; }
 
-const char* kernel_name(Kernel k) {
-  switch (k) {
-    case Kernel::Megakernel: return "megakernel";
-    case Kernel::MegakernelConstant: return "megakernel-constant";
-    case Kernel::Wavefront: return "wavefront";
-    case Kernel::WavefrontUnsorted: return "wavefront-unsorted";
-  }
-  return "?";
-}
 
 void validate_params(const RenderParams& p) {
   for (SettingId id : render_settings()) check_setting(id, get_param(p, id));

@@ -3,12 +3,12 @@
 #pragma once
 
 #include "render/render_types.hpp"
+#include "render/settings.hpp"
 #include "scene/scene.hpp"
 
 namespace wt {
 
 const char* backend_name(Backend b);
-const char* kernel_name(Kernel k);
 
 // Fails with SceneError for settings the backend cannot honour (naming the setting),
 // and DeviceError (cuda::CudaError for CUDA calls, naming the call and the stage)

@@ -64,15 +64,48 @@ void check_setting(SettingId id, int64_t value) {
   }
 }
 
+namespace {
+
+struct KernelInfo {
+  Kernel kernel;
+  const char* name;
+  bool cuda_only;
+};
+
+// The one list of kernels: their names, in the order the docs and plots list them,
+// and where they run. The constant-memory megakernel needs CUDA's __constant__ memory.
+const std::vector<KernelInfo>& kernel_table() {
+  static const std::vector<KernelInfo> table = {
+      {Kernel::Megakernel, "megakernel", false},
+      {Kernel::MegakernelConstant, "megakernel-constant", true},
+      {Kernel::Wavefront, "wavefront", false},
+      {Kernel::WavefrontUnsorted, "wavefront-unsorted", false},
+  };
+  return table;
+}
+
+const KernelInfo& kernel_info(Kernel k) {
+  for (const KernelInfo& info : kernel_table()) {
+    if (info.kernel == k) return info;
+  }
+  throw std::logic_error("a kernel missing from the kernel table");
+}
+
+}  // namespace
+
+const char* kernel_name(Kernel k) { return kernel_info(k).name; }
+
 const std::vector<Kernel>& kernels() {
-  static const std::vector<Kernel> all = {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront,
-                                          Kernel::WavefrontUnsorted};
+  static const std::vector<Kernel> all = [] {
+    std::vector<Kernel> out;
+    for (const KernelInfo& info : kernel_table()) out.push_back(info.kernel);
+    return out;
+  }();
   return all;
 }
 
-// The constant-memory megakernel needs CUDA's __constant__ memory.
 bool kernel_runs_on(Kernel kernel, Backend backend) {
-  return backend == Backend::Cuda || kernel != Kernel::MegakernelConstant;
+  return backend == Backend::Cuda || !kernel_info(kernel).cuda_only;
 }
 
 std::vector<std::string> kernel_names() {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.hpp"
+#include "render/render_types.hpp"
 
 namespace wt {
 
@@ -39,8 +39,10 @@ void set_param(RenderParams& p, SettingId id, int64_t value);
 // Throws SceneError "<key>: must be in lo..hi (got value)" when value is out of range.
 void check_setting(SettingId id, int64_t value);
 
-// The kernels, in the order the docs and plots list them, and the backends each runs on.
+// The kernels, in the order the docs and plots list them, their names, and the
+// backends each runs on.
 const std::vector<Kernel>& kernels();
+const char* kernel_name(Kernel k);
 bool kernel_runs_on(Kernel kernel, Backend backend);
 std::vector<std::string> kernel_names();
 std::vector<std::string> kernel_names(Backend backend);
