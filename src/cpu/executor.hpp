@@ -86,12 +86,7 @@ class Executor {
   double elapsed_host() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
 
   // Each stage's milliseconds since the last call, by stage index.
-  std::vector<double> take_stage_ms(size_t stages) {
-    std::vector<double> ms(stages, 0.0);
-    for (size_t i = 0; i < stages && i < ms_.size(); ++i) ms[i] = ms_[i];
-    ms_.clear();
-    return ms;
-  }
+  std::vector<double> take_stage_ms(size_t stages) { return times_.take(stages); }
 
  private:
   static constexpr int64_t kChunk = 1024;
@@ -100,13 +95,12 @@ class Executor {
   void timed(const Stage& s, F&& f) {
     const auto t0 = Clock::now();
     f();
-    if (ms_.size() <= static_cast<size_t>(s.index)) ms_.resize(s.index + 1, 0.0);
-    ms_[s.index] += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    times_.add(s.index, std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
   }
 
   int threads_;
   Clock::time_point start_ = Clock::now();
-  std::vector<double> ms_;
+  StageTimes times_;
 };
 
 }  // namespace wt::cpu

@@ -149,12 +149,7 @@ class Executor {
   double elapsed_host() const { return timer_.elapsed_host(); }
 
   // Each stage's milliseconds since the last call, by stage index. Call after stop_timer().
-  std::vector<double> take_stage_ms(size_t stages) {
-    std::vector<double> ms(stages, 0.0);
-    for (size_t i = 0; i < stages && i < ms_.size(); ++i) ms[i] = ms_[i];
-    ms_.clear();
-    return ms;
-  }
+  std::vector<double> take_stage_ms(size_t stages) { return times_.take(stages); }
 
  private:
   static constexpr size_t kPinnedBytes = 256;
@@ -188,8 +183,7 @@ class Executor {
   // Adds the times of every pending stage (all complete: the stream was waited on).
   void collect() {
     for (const Pending& p : pending_) {
-      if (ms_.size() <= static_cast<size_t>(p.stage)) ms_.resize(p.stage + 1, 0.0);
-      ms_[p.stage] += p.end->ms_since(*p.begin, "wavefront timing");
+      times_.add(p.stage, p.end->ms_since(*p.begin, "wavefront timing"));
       free_.push_back(p.begin);
       free_.push_back(p.end);
     }
@@ -202,7 +196,7 @@ class Executor {
   std::vector<std::unique_ptr<Event>> events_;
   std::vector<Event*> free_;
   std::vector<Pending> pending_;
-  std::vector<double> ms_;
+  StageTimes times_;
 };
 
 }  // namespace wt::cuda
