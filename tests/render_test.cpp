@@ -7,6 +7,7 @@
 
 #include "cuda/cuda_backend.hpp"
 #include "megakernel/megakernel.hpp"
+#include "render/passes.hpp"
 #include "render/renderer.hpp"
 #include "test_support.hpp"
 
@@ -99,6 +100,98 @@ TEST_P(EveryKernel, SameSeedSameImageOtherSeedOtherImage) {
   }
   EXPECT_EQ(a.rays, b.rays);
   EXPECT_GT(mean_abs_diff(a.rgb, c.rgb), 1e-2);
+}
+
+// Float sums of the same samples grouped or ordered differently (passes, the
+// wavefront's film atomics) agree to a few ulps of the largest pixel value.
+void expect_same_image(const std::vector<float>& a, const std::vector<float>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-5f * std::max(1.0f, std::fabs(a[i]))) << i;
+}
+
+// A render split into passes by the path limit (lowered here: 2^32 paths split a
+// big render the same way) traces the same paths and gives the same image.
+TEST_P(EveryKernel, PassesOverThePathLimitTraceTheSamePaths) {
+  const Scene scene = load_scene(test::repo_path("scenes/quick.json"));
+  RenderOptions whole = options_for(GetParam().backend, GetParam().kernel, 24, 16, 12, 8, 3, 5);
+  const RenderResult a = render(scene, whole);
+  RenderOptions split = whole;
+  split.max_paths_per_pass = 24 * 16 * 5;  // at most 5 samples of every pixel in a pass
+  std::vector<int32_t> done;
+  split.after_pass = [&](int32_t samples, const FilmReader&) {
+    done.push_back(samples);
+    return true;
+  };
+  const RenderResult b = render(scene, split);
+  ASSERT_GE(done.size(), 3u);
+  EXPECT_EQ(done.back(), 12);
+  for (size_t i = 1; i < done.size(); ++i) EXPECT_LE(done[i] - done[i - 1], 5);
+  EXPECT_EQ(b.samples, 12);
+  EXPECT_FALSE(b.interrupted);
+  EXPECT_EQ(b.paths, 24u * 16u * 12u);
+  EXPECT_EQ(b.rays, a.rays);
+  expect_same_image(a.rgb, b.rgb);
+}
+
+// Stopped after a pass, then started again from the film's sums at that sample:
+// the same paths, the same image as the render that ran through.
+TEST_P(EveryKernel, AStoppedRenderResumedFromItsFilmEqualsTheWholeRender) {
+  const Scene scene = load_scene(test::repo_path("scenes/quick.json"));
+  RenderOptions whole = options_for(GetParam().backend, GetParam().kernel, 24, 16, 12, 8, 3, 5);
+  whole.samples_per_pass = 4;
+  const RenderResult a = render(scene, whole);
+
+  RenderOptions first = whole;
+  std::vector<float> sums;
+  first.after_pass = [&](int32_t samples, const FilmReader& film) {
+    if (samples < 8) return true;
+    sums = film();
+    return false;
+  };
+  const RenderResult stopped = render(scene, first);
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_EQ(stopped.samples, 8);
+  ASSERT_EQ(sums.size(), a.rgb.size());
+
+  RenderOptions rest = whole;
+  rest.first_sample = 8;
+  rest.initial_film = &sums;
+  const RenderResult resumed = render(scene, rest);
+  EXPECT_FALSE(resumed.interrupted);
+  EXPECT_EQ(resumed.samples, 12);
+  EXPECT_EQ(stopped.paths + resumed.paths, a.paths);
+  EXPECT_EQ(stopped.rays + resumed.rays, a.rays);
+  expect_same_image(a.rgb, resumed.rgb);
+}
+
+TEST(SamplePasses, AreEvenAndCoverTheSamplesOnce) {
+  const auto passes = plan_passes(100, 3, 25, 4, 0, kMaxPathsPerPass);
+  ASSERT_EQ(passes.size(), 4u);
+  int32_t at = 3;
+  for (const SamplePass& p : passes) {
+    EXPECT_EQ(p.first, at);
+    EXPECT_TRUE(p.count == 6 || p.count == 7);
+    at += p.count;
+  }
+  EXPECT_EQ(at, 28);
+}
+
+TEST(SamplePasses, HoldAtMostThePathLimitAndTheSamplesAsked) {
+  // 3840 x 2160 x 4096 spp is 34 G paths: at most 2^32 - 1 in a pass.
+  const uint64_t pixels = 3840ull * 2160;
+  const auto big = plan_passes(pixels, 0, 4096, 1, 0, kMaxPathsPerPass);
+  EXPECT_EQ(big.size(), 8u);
+  for (const SamplePass& p : big) EXPECT_LE(pixels * p.count, kMaxPathsPerPass);
+  const auto asked = plan_passes(10, 0, 100, 1, 7, kMaxPathsPerPass);
+  EXPECT_EQ(asked.size(), 15u);
+  for (const SamplePass& p : asked) EXPECT_LE(p.count, 7);
+  // Never fewer samples than passes: at most one pass a sample.
+  EXPECT_EQ(plan_passes(10, 0, 3, 10, 0, kMaxPathsPerPass).size(), 3u);
+}
+
+TEST(RenderSettings, BigRendersPassTheChecks) {
+  RenderParams p{3840, 2160, 4096, 30, 30, 1};
+  EXPECT_NO_THROW(validate_params(p));
 }
 
 std::vector<Variant> all_variants() {

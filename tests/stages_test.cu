@@ -168,7 +168,7 @@ TYPED_TEST(Stages, IntersectStartsCameraPathsInTheFreeSlots) {
   // 0); the free slots 5..15 start paths 40..50.
   Side::upload(w.counters, std::vector<WaveCounters>{WaveCounters{{5, 0}, 40, 0, 0}});
   this->ex->launch(stage::kIntersect, 16,
-                   IntersectItem{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 16, film});
+                   IntersectItem{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 16, film});
   std::vector<ImageView> images;
   const SceneView host = host_view(scene, kParams.width, kParams.height, images);
   for (uint32_t slot = 5; slot < 16; ++slot) {
@@ -190,13 +190,19 @@ TEST(GenerateStage, StartPathIsTheCameraRayOfTheSlotsPath) {
   Scene scene = stage_scene();
   std::vector<ImageView> images;
   const SceneView view = host_view(scene, kParams.width, kParams.height, images);
-  const PathState s = start_path(9, 5, 40, view, kParams);
+  const PathState s = start_path(9, 5, 40, 0, view, kParams);
   EXPECT_EQ(s.path, 44u);
   EXPECT_EQ(s.bounce, 0u);
   EXPECT_EQ(s.throughput, vec3(1.0f));
   const Ray expect = primary_ray(view, kParams, 44 % kPixels, 44 / kPixels);
   EXPECT_EQ(s.ray.origin, expect.origin);
   EXPECT_EQ(s.ray.dir, expect.dir);
+  // In a pass that starts at sample 2, the same path index is two samples later.
+  const PathState later = start_path(9, 5, 40, 2, view, kParams);
+  const Ray expect_later = primary_ray(view, kParams, 44 % kPixels, 2 + 44 / kPixels);
+  EXPECT_EQ(later.path, 44u);
+  EXPECT_EQ(later.ray.dir, expect_later.dir);
+  EXPECT_NE(later.ray.dir, s.ray.dir);
 }
 
 TEST(GenerateStage, EveryPathIsGeneratedExactlyOnceAcrossWaves) {
@@ -236,7 +242,7 @@ TYPED_TEST(Stages, IntersectFindsClosestHitsAddsSkyForMissesAndCountsRays) {
   // All paths handed out: live = queued = 4; slots 4..7 must come out as misses.
   Side::upload(w.counters, std::vector<WaveCounters>{WaveCounters{{4, 77}, kTotal, 0, 100}});
   this->ex->launch(stage::kIntersect, 8,
-                   IntersectItem{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 8, film});
+                   IntersectItem{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 8, film});
   this->ex->launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, 0, kTotal, 8});
 
   const auto t = Side::download(w.hits.t, 4);
@@ -356,7 +362,7 @@ TEST(ShadeStage, EachMaterialScattersAsItsDefinitionSays) {
   ShadeCase sc;
   PathState next[3];
   for (uint32_t i = 0; i < 3; ++i) {
-    ASSERT_TRUE(shade_one(i, sc.view, kParams, sc.q, sc.hits, sc.film.data(), next[i])) << i;
+    ASSERT_TRUE(shade_one(i, 0, sc.view, kParams, sc.q, sc.hits, sc.film.data(), next[i])) << i;
     EXPECT_EQ(next[i].bounce, 2u);
     EXPECT_EQ(next[i].path, 7 + i);
   }
@@ -380,7 +386,7 @@ TEST(ShadeStage, PathsAtTheDepthLimitEnd) {
   RenderParams shallow = kParams;
   shallow.depth = 2;  // the paths are at bounce 1: their next ray would be the third
   PathState next;
-  for (uint32_t i = 0; i < 3; ++i) EXPECT_FALSE(shade_one(i, sc.view, shallow, sc.q, sc.hits, sc.film.data(), next));
+  for (uint32_t i = 0; i < 3; ++i) EXPECT_FALSE(shade_one(i, 0, sc.view, shallow, sc.q, sc.hits, sc.film.data(), next));
 }
 
 TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
@@ -394,7 +400,7 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   Side::upload(w.hits.sphere, sc.sphere);
   Side::upload(w.selected, std::vector<uint32_t>{pack_entry(0, 2), pack_entry(0, 0), pack_entry(0, 1)});
   this->ex->launch(stage::kShade, 3,
-                   ShadeItem{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected,
+                   ShadeItem{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected, 0,
                              film});
   ASSERT_EQ(Side::download(&w.counters->queued[1], 1)[0], 3u);
   std::map<uint32_t, PathState> pushed;
@@ -404,7 +410,7 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   }
   for (uint32_t i = 0; i < 3; ++i) {
     PathState expect;
-    ASSERT_TRUE(shade_one(i, sc.view, kParams, sc.q, sc.hits, sc.film.data(), expect));
+    ASSERT_TRUE(shade_one(i, 0, sc.view, kParams, sc.q, sc.hits, sc.film.data(), expect));
     ASSERT_EQ(pushed.count(expect.path), 1u);
     const PathState& got = pushed[expect.path];
     for (int k = 0; k < 3; ++k) {

@@ -7,6 +7,7 @@
 
 #include "cpu/cpu_wavefront.hpp"
 #include "cpu/parallel.hpp"
+#include "render/passes.hpp"
 #include "render/settings.hpp"
 #include "wavetrace/path.hpp"
 
@@ -20,37 +21,58 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, const RenderOptions& options) {
+// Pass after pass of samples, each over rows of pixels on every core.
+RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, const RenderOptions& options,
+                               bool last) {
   RenderResult out;
   const int64_t pixels = static_cast<int64_t>(rp.width) * rp.height;
-  out.rgb.assign(pixels * 3, 0.0f);
+  if (options.initial_film) {
+    out.rgb = *options.initial_film;
+  } else {
+    out.rgb.assign(pixels * 3, 0.0f);
+  }
+  out.samples = options.first_sample;
+  const std::vector<SamplePass> passes = plan_passes(options, 1);
   std::atomic<uint64_t> rays{0};
   std::atomic<int64_t> pixels_done{0};
   const int threads = thread_count(options.threads);
   auto t0 = Clock::now();
   auto last_report = t0;
-  // One row per chunk: whole rows keep the progress steady and the cache warm.
-  parallel_for(pixels, rp.width, threads, [&](int64_t begin, int64_t end, int tid) {
-    uint32_t local_rays = 0;
-    for (int64_t p = begin; p < end; ++p) {
-      vec3 sum(0.0f);
-      for (int s = 0; s < rp.spp; ++s) {
-        sum += trace_path(view, rp, static_cast<uint32_t>(p), static_cast<uint32_t>(s), local_rays);
+  const int64_t all_pixels = pixels * static_cast<int64_t>(passes.size());
+  for (size_t p = 0; p < passes.size(); ++p) {
+    const SamplePass& pass = passes[p];
+    // One row per chunk: whole rows keep the progress steady and the cache warm.
+    parallel_for(pixels, rp.width, threads, [&](int64_t begin, int64_t end, int tid) {
+      uint32_t path_rays = 0;
+      uint64_t local_rays = 0;
+      for (int64_t px = begin; px < end; ++px) {
+        vec3 sum(0.0f);
+        for (int32_t s = pass.first; s < pass.first + pass.count; ++s) {
+          path_rays = 0;
+          sum += trace_path(view, rp, static_cast<uint32_t>(px), static_cast<uint32_t>(s), path_rays);
+          local_rays += path_rays;
+        }
+        out.rgb[3 * px + 0] += sum.x;
+        out.rgb[3 * px + 1] += sum.y;
+        out.rgb[3 * px + 2] += sum.z;
       }
-      out.rgb[3 * p + 0] = sum.x;
-      out.rgb[3 * p + 1] = sum.y;
-      out.rgb[3 * p + 2] = sum.z;
-    }
-    uint64_t total = rays.fetch_add(local_rays) + local_rays;
-    int64_t done = pixels_done.fetch_add(end - begin) + (end - begin);
-    if (options.progress && tid == 0) {  // only this thread touches last_report
-      auto now = Clock::now();
-      if (now - last_report > std::chrono::milliseconds(250)) {
-        last_report = now;
-        options.progress(static_cast<double>(done) / pixels, total, seconds_since(t0));
+      const uint64_t total = rays.fetch_add(local_rays) + local_rays;
+      const int64_t done = pixels_done.fetch_add(end - begin) + (end - begin);
+      if (last && options.progress && tid == 0) {  // only this thread touches last_report
+        auto now = Clock::now();
+        if (now - last_report > std::chrono::milliseconds(250)) {
+          last_report = now;
+          options.progress(static_cast<double>(done) / all_pixels, total, seconds_since(t0));
+        }
       }
+    });
+    out.samples = pass.first + pass.count;
+    out.paths += static_cast<uint64_t>(pixels) * pass.count;
+    if (last && options.after_pass && !options.after_pass(out.samples, [&] { return out.rgb; })) {
+      out.interrupted = p + 1 < passes.size();
+      break;
     }
-  });
+  }
   out.seconds = seconds_since(t0);
   out.rays = rays.load();
   out.radiance = Radiance::SumOfSamples;
@@ -71,14 +93,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   RenderResult out;
   if (options.kernel == Kernel::Megakernel) {
     // Warm-up renders, as on the GPU, so that timings compare like with like.
-    RenderOptions silent = options;
-    silent.progress = nullptr;
-    for (int i = 0; i < options.warmup; ++i) render_megakernel(view, rp, silent);
-    out = render_megakernel(view, rp, options);
+    for (int i = 0; i < options.warmup; ++i) render_megakernel(view, rp, options, false);
+    out = render_megakernel(view, rp, options, true);
   } else {
     out = render_wavefront(view, scene.sort_key_bits(), options, choose_wave_size(options.wave_size, rp));
   }
-  out.paths = static_cast<uint64_t>(rp.width) * rp.height * rp.spp;
   out.device = "CPU (" + std::to_string(thread_count(options.threads)) + " threads)";
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;

@@ -11,6 +11,7 @@
 #include "cuda/event.hpp"
 #include "megakernel/megakernel.hpp"
 #include "cuda/cuda_wavefront.hpp"
+#include "render/passes.hpp"
 
 namespace wt::cuda {
 
@@ -20,8 +21,9 @@ constexpr const char* kStage = "render";
 
 std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB"; }
 
-// The megakernel renders in a few passes of samples so that progress can be shown
-// between them; the next pass is queued before the host waits on the last one.
+// The megakernel renders in passes of samples (at least ten, so that progress can
+// be shown between them); the next pass is queued before the host waits on the
+// last one, unless after_pass must see each pass's film.
 RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
@@ -29,36 +31,50 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   DeviceBuffer<float> film(pixels * 3, kStage);
   DeviceBuffer<unsigned long long> rays(1, kStage);
-  const int passes = std::min(rp.spp, 10);
+  const std::vector<SamplePass> passes = plan_passes(options, 10);
 
-  auto run = [&](bool report) {
-    film.zero(kStage);
+  RenderResult out;
+  auto run = [&](bool last) {
+    if (options.initial_film) {
+      film.upload(*options.initial_film, kStage);
+    } else {
+      film.zero(kStage);
+    }
     rays.zero(kStage);
+    out.samples = options.first_sample;
+    out.interrupted = false;
+    out.paths = 0;
     EventTimer timer("megakernel");
     timer.start();
-    std::vector<Event> pass_done(passes);
-    int first = 0;
-    for (int p = 0; p < passes; ++p) {
-      int samples = rp.spp / passes + (p < rp.spp % passes ? 1 : 0);
+    std::vector<Event> pass_done(passes.size());
+    for (size_t p = 0; p < passes.size(); ++p) {
+      const SamplePass& pass = passes[p];
       if (constant) {
-        launch_megakernel_constant(rp, first, samples, film.get(), rays.get(), nullptr);
+        launch_megakernel_constant(rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
       } else {
-        launch_megakernel(ds.view(), rp, first, samples, film.get(), rays.get(), nullptr);
+        launch_megakernel(ds.view(), rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
       }
       pass_done[p].record("megakernel");
-      first += samples;
-      if (report && p > 0) {
+      out.samples = pass.first + pass.count;
+      out.paths += pixels * static_cast<uint64_t>(pass.count);
+      if (last && options.after_pass) {
+        pass_done[p].synchronize("megakernel");
+        if (!options.after_pass(out.samples, [&] { return film.download(kStage); })) {
+          out.interrupted = p + 1 < passes.size();
+          break;
+        }
+      }
+      if (last && options.progress && p > 0) {
         pass_done[p - 1].synchronize("megakernel");
         unsigned long long so_far = 0;
         WT_CUDA(cudaMemcpy(&so_far, rays.get(), sizeof(so_far), cudaMemcpyDeviceToHost), "megakernel");
-        options.progress(static_cast<double>(p) / passes, so_far, timer.elapsed_host());
+        options.progress(static_cast<double>(p) / passes.size(), so_far, timer.elapsed_host());
       }
     }
     return timer.stop();
   };
   for (int i = 0; i < options.warmup; ++i) run(false);
-  RenderResult out;
-  out.seconds = run(static_cast<bool>(options.progress));
+  out.seconds = run(true);
   unsigned long long counted = 0;
   WT_CUDA(cudaMemcpy(&counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
   out.rays = counted;
@@ -107,7 +123,6 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
 
   RenderResult out = wavefront ? render_wavefront(ds.view(), scene.sort_key_bits(), options, wave) : render_megakernel(scene, ds, options);
   out.upload_seconds = upload;
-  out.paths = static_cast<uint64_t>(rp.width) * rp.height * rp.spp;
   out.device = info.name;
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;

@@ -133,6 +133,10 @@ class Executor {
 
   void zero(void* p, size_t bytes) { WT_CUDA(cudaMemsetAsync(p, 0, bytes, stream_), "wavefront"); }
 
+  void upload(float* p, const std::vector<float>& v) {
+    WT_CUDA(cudaMemcpyAsync(p, v.data(), v.size() * sizeof(float), cudaMemcpyHostToDevice, stream_), "wavefront");
+  }
+
   std::vector<float> download(const float* p, size_t n) {
     std::vector<float> host(n);
     WT_CUDA(cudaMemcpyAsync(host.data(), p, n * sizeof(float), cudaMemcpyDeviceToHost, stream_), "wavefront");

@@ -26,8 +26,10 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
     f[1] += sum.y;
     f[2] += sum.z;
   }
-  // One atomic per warp, not per ray: every lane reaches this point.
-  const uint32_t warp_total = __reduce_add_sync(0xffffffffu, count);
+  // One atomic per warp, not per ray: every lane reaches this point. The warp's sum
+  // is taken in 64 bits, since 32 lanes of a long pass can pass 2^32 rays.
+  unsigned long long warp_total = count;
+  for (int offset = 16; offset > 0; offset /= 2) warp_total += __shfl_down_sync(0xffffffffu, warp_total, offset);
   if ((threadIdx.x + threadIdx.y * blockDim.x) % 32 == 0 && warp_total) atomicAdd(rays, warp_total);
 }
 

@@ -13,7 +13,7 @@ namespace wt {
 struct PathState {
   Ray ray;
   vec3 throughput;
-  uint32_t path;    // path index: pixel = path % pixels, sample = path / pixels
+  uint32_t path;    // path index within its pass: pixel = path % pixels, sample = pass's first + path / pixels
   uint32_t bounce;  // rays this path has traced so far
 };
 

@@ -21,6 +21,17 @@ inline bool is_wavefront(Kernel k) { return k == Kernel::Wavefront || k == Kerne
 // Progress of a render: fraction of paths done, rays so far, seconds since start.
 using ProgressFn = std::function<void(double done, uint64_t rays, double seconds)>;
 
+// Reads the film's running sums back (linear RGB per pixel, row 0 = top).
+using FilmReader = std::function<std::vector<float>()>;
+
+// Called after each pass of samples with the samples of every pixel the film now
+// sums (from sample 0); returning false stops the render there.
+using PassFn = std::function<bool(int32_t samples_done, const FilmReader& film)>;
+
+// Within a pass a path is a 32-bit index (pixel + pixels x sample within the pass):
+// no pass holds more paths than this, so any number of paths can be rendered.
+constexpr uint64_t kMaxPathsPerPass = 0xffffffffull;
+
 struct RenderOptions {
   RenderParams params{};
   Backend backend = Backend::Cpu;
@@ -29,6 +40,19 @@ struct RenderOptions {
   int64_t wave_size = 0;  // wavefront path slots; 0 chooses (queues/wave.hpp)
   int threads = 0;        // CPU threads; 0 uses every core
   ProgressFn progress;    // may be empty
+
+  // The samples of every pixel this render adds: [first_sample, first_sample +
+  // sample_count); 0 samples: up to params.spp. The film starts from
+  // `initial_film`, the sums of samples [0, first_sample), when it is given (a
+  // resumed render), else from zero.
+  int32_t first_sample = 0;
+  int32_t sample_count = 0;
+  const std::vector<float>* initial_film = nullptr;
+  // Passes of at most this many samples (0: as few passes as the limits allow),
+  // each followed by `after_pass` when it is given.
+  int32_t samples_per_pass = 0;
+  uint64_t max_paths_per_pass = kMaxPathsPerPass;  // lowered only by tests
+  PassFn after_pass;
 };
 
 struct StageTime {
@@ -43,8 +67,10 @@ enum class Radiance { SumOfSamples, MeanOfSamples };
 struct RenderResult {
   std::vector<float> rgb;  // linear RGB per pixel, row 0 = top; what it holds: `radiance`
   Radiance radiance = Radiance::SumOfSamples;
-  uint64_t rays = 0;   // every ray intersected, counted once
-  uint64_t paths = 0;  // pixels x samples
+  int32_t samples = 0;       // samples per pixel the film sums (from sample 0)
+  bool interrupted = false;  // after_pass stopped the render before its last sample
+  uint64_t rays = 0;   // every ray this render intersected, counted once
+  uint64_t paths = 0;  // pixels x samples this render traced
   double seconds = 0;  // the render alone: CUDA events on the GPU, wall clock on the CPU
   double upload_seconds = 0;
   std::string device;

@@ -13,21 +13,29 @@ const char* backend_name(Backend b) { return b == Backend::Cuda ? "cuda" : "cpu"
 
 void validate_params(const RenderParams& p) {
   for (SettingId id : render_settings()) check_setting(id, get_param(p, id));
-  // Path indices are 32-bit on every backend.
-  if (static_cast<uint64_t>(p.width) * p.height * p.spp > 0xffffffffull) {
-    throw SceneError("spp: width x height x spp must stay below 2^32 paths (got " +
-                     std::to_string(static_cast<uint64_t>(p.width) * p.height * p.spp) + ")");
-  }
 }
 
 RenderParams default_params(const Scene& scene) { return scene.render; }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
-  validate_params(options.params);
+  const RenderParams& p = options.params;
+  validate_params(p);
   if (options.wave_size != 0) check_setting(SettingId::WaveSize, options.wave_size);
+  if (options.first_sample < 0 || options.first_sample >= p.spp || options.sample_count < 0 ||
+      options.sample_count > p.spp - options.first_sample) {
+    throw SceneError("samples: " + std::to_string(options.first_sample) + " + " +
+                     std::to_string(options.sample_count) + " does not lie within the " + std::to_string(p.spp) +
+                     " samples per pixel");
+  }
+  const size_t film_floats = static_cast<size_t>(p.width) * p.height * 3;
+  if (options.initial_film && options.initial_film->size() != film_floats) {
+    throw SceneError("film: the sums to start from hold " + std::to_string(options.initial_film->size()) +
+                     " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
+                     std::to_string(film_floats));
+  }
   RenderResult r = options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
   // The backends return each pixel's sum over its samples: the mean is taken here, once.
-  const float inv = 1.0f / static_cast<float>(options.params.spp);
+  const float inv = 1.0f / static_cast<float>(r.samples);
   for (float& v : r.rgb) v *= inv;
   r.radiance = Radiance::MeanOfSamples;
   return r;

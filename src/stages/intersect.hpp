@@ -43,7 +43,8 @@ struct IntersectItem {
   uint32_t* entries;
   const WaveCounters* counters;
   int cur;
-  uint32_t total_paths;
+  uint32_t total_paths;  // of this pass
+  uint32_t first_sample;  // of this pass
   uint32_t capacity;
   float* film;
 
@@ -56,7 +57,7 @@ struct IntersectItem {
     }
     Ray ray;
     if (i >= queued) {
-      const PathState s = start_path(i, queued, next_path, scene, rp);
+      const PathState s = start_path(i, queued, next_path, first_sample, scene, rp);
       queue.store(i, s);
       ray = s.ray;
     } else {

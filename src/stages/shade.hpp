@@ -10,15 +10,17 @@
 
 namespace wt {
 
-// Scatters the path in slot `slot`; on true `next` is the path's next bounce.
+// Scatters the path in slot `slot` (of the pass whose first sample is
+// `first_sample`); on true `next` is the path's next bounce.
 template <class Scene>
-WT_HD WT_INLINE bool shade_one(uint32_t slot, const Scene& scene, const RenderParams& rp, const PathQueue& q,
-                               const HitQueue& hits, float* film, PathState& next) {
+WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene& scene, const RenderParams& rp,
+                               const PathQueue& q, const HitQueue& hits, float* film, PathState& next) {
   PathState s = q.load(slot);
   const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
   const uint32_t pixel = s.path % pixels;
   vec3 radiance(0.0f);
-  bool alive = shade_hit(scene, rp, hits.load(slot), pixel, s.path / pixels, s.bounce, s.ray, s.throughput, radiance);
+  bool alive = shade_hit(scene, rp, hits.load(slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
+                         s.throughput, radiance);
   if (radiance.x != 0.0f || radiance.y != 0.0f || radiance.z != 0.0f) accumulate_one(film, pixel, radiance);
   s.bounce += 1;
   next = s;
@@ -34,11 +36,12 @@ struct ShadeItem {
   PathQueue next_queue;
   uint32_t* next_count;
   const uint32_t* list;
+  uint32_t first_sample;  // of this pass
   float* film;
 
   WT_HD void operator()(uint32_t i) const {
     PathState next;
-    const bool alive = shade_one(entry_slot(list[i]), scene, rp, queue, hits, film, next);
+    const bool alive = shade_one(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next);
     // Every item reaches the push, so that a warp reserves its slots with one atomic.
     const uint32_t slot = push_slot(next_count, alive);
     if (alive) next_queue.store(slot, next);

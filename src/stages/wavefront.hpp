@@ -12,7 +12,7 @@
 //   sort(stage, keys, alternate, n, bits, temp, temp_bytes) -> the buffer holding the result
 //                                            (stable, over the key bits alone)
 //   read(stage, const T*) -> T               reads a value back to the host
-//   zero(p, bytes), download(const float*, n)
+//   zero(p, bytes), upload(float*, const vector<float>&), download(const float*, n)
 //   start_timer(), stop_timer() -> seconds, elapsed_host(), take_stage_ms(count)
 // Every launch goes through launch/select/sort/read with its stage, and is timed
 // by the executor under that stage's name.
@@ -21,6 +21,7 @@
 #include <array>
 #include <vector>
 
+#include "render/passes.hpp"
 #include "render/render_types.hpp"
 #include "stages/compact.hpp"
 #include "stages/generate.hpp"
@@ -48,15 +49,19 @@ size_t wavefront_bytes(size_t capacity) {
   return wave_bytes(capacity, Exec::temp_bytes(capacity));
 }
 
-// Renders with a wave of `capacity` slots; the result holds pixel sums.
+// Renders with a wave of `capacity` slots, pass after pass of samples (each pass's
+// paths are numbered from 0 in 32 bits); the result holds pixel sums.
 template <class Exec>
 RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, const RenderOptions& options,
                               int64_t capacity) {
   const RenderParams& rp = options.params;
   const bool sorted = options.kernel == Kernel::Wavefront;
-  const uint32_t total = static_cast<uint32_t>(static_cast<uint64_t>(rp.width) * rp.height * rp.spp);
+  const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
+  const std::vector<SamplePass> passes = plan_passes(options, 1);
+  const uint64_t all_paths = pixels * static_cast<uint64_t>(passes.empty() ? 0 : passes.back().first +
+                                                                                   passes.back().count - passes.front().first);
   const uint32_t slots = static_cast<uint32_t>(capacity);
-  const size_t film_floats = static_cast<size_t>(rp.width) * rp.height * 3;
+  const size_t film_floats = static_cast<size_t>(pixels) * 3;
 
   size_t bytes = 0;
   const size_t temp_bytes = Exec::temp_bytes(slots);
@@ -66,40 +71,65 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   float* film = reinterpret_cast<float*>(film_memory.get());
 
   RenderResult out;
-  auto run = [&](bool report) {
-    ex.zero(film, film_floats * sizeof(float));
-    ex.zero(w.counters, sizeof(WaveCounters));
+  auto run = [&](bool last) {
+    if (options.initial_film) {
+      ex.upload(film, *options.initial_film);
+    } else {
+      ex.zero(film, film_floats * sizeof(float));
+    }
     std::vector<uint64_t> live_per_bounce;
+    uint64_t rays = 0, paths_done = 0;
+    out.samples = options.first_sample;
+    out.interrupted = false;
     ex.start_timer();
-    for (int cur = 0;; cur = 1 - cur) {
-      ex.launch(stage::kIntersect, slots,
-                IntersectItem{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, slots, film});
-      ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
-      ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp, w.temp_bytes);
-      const WaveCounters c = ex.read(stage::kReadback, w.counters);
-      live_per_bounce.push_back(c.queued[cur]);
+    for (const SamplePass& pass : passes) {
+      const uint32_t total = static_cast<uint32_t>(pixels * static_cast<uint64_t>(pass.count));
+      const uint32_t first = static_cast<uint32_t>(pass.first);
+      ex.zero(w.counters, sizeof(WaveCounters));
+      for (int cur = 0;; cur = 1 - cur) {
+        ex.launch(stage::kIntersect, slots,
+                  IntersectItem{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, first, slots, film});
+        ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
+        ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,
+                  w.temp_bytes);
+        const WaveCounters c = ex.read(stage::kReadback, w.counters);
+        live_per_bounce.push_back(c.queued[cur]);
 
-      const uint32_t* list = w.selected;
-      if (sorted && c.hits > 0) {
-        list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
+        const uint32_t* list = w.selected;
+        if (sorted && c.hits > 0) {
+          list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
+        }
+        ex.launch(stage::kShade, c.hits,
+                  ShadeItem{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], list,
+                            first, film});
+        if (last && options.progress) {
+          options.progress(static_cast<double>(paths_done + c.next_path - c.queued[cur]) / all_paths, rays + c.rays,
+                           ex.elapsed_host());
+        }
+        if (c.hits == 0 && c.next_path >= total) {
+          rays += c.rays;
+          break;
+        }
       }
-      ex.launch(stage::kShade, c.hits,
-                ShadeItem{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], list, film});
-      if (report) {
-        options.progress(static_cast<double>(c.next_path - c.queued[cur]) / total, c.rays, ex.elapsed_host());
+      paths_done += total;
+      out.samples = pass.first + pass.count;
+      if (last && options.after_pass &&
+          !options.after_pass(out.samples, [&] { return ex.download(film, film_floats); })) {
+        out.interrupted = out.samples < passes.back().first + passes.back().count;
+        break;
       }
-      if (c.hits == 0 && c.next_path >= total) break;
     }
     out.seconds = ex.stop_timer();
+    out.rays = rays;
+    out.paths = paths_done;
     const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
     out.stages.clear();
     for (const Stage& s : stage::kAll) out.stages.push_back(StageTime{s.name, ms[s.index]});
     out.live_per_bounce = std::move(live_per_bounce);
   };
   for (int i = 0; i < options.warmup; ++i) run(false);
-  run(static_cast<bool>(options.progress));
+  run(true);
 
-  out.rays = ex.read(stage::kReadback, w.counters).rays;
   out.rgb = ex.download(film, film_floats);
   out.radiance = Radiance::SumOfSamples;
   return out;
