@@ -8,33 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <fstream>
 
 #include "render/renderer.hpp"
 #include "test_support.hpp"
 
 namespace wt {
 namespace {
-
-// A PFM as the command writes it: "PF", width, height, -1.0 (little-endian), bottom row first.
-std::vector<float> read_pfm(const std::string& path, int width, int height) {
-  std::ifstream f(path, std::ios::binary);
-  std::string magic;
-  int w = 0, h = 0;
-  float scale = 0;
-  f >> magic >> w >> h >> scale;
-  f.get();
-  if (!f || magic != "PF" || w != width || h != height || scale != -1.0f) {
-    ADD_FAILURE() << path << ": not a " << width << "x" << height << " little-endian PFM";
-    return {};
-  }
-  std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
-  for (int y = h - 1; y >= 0; --y) {
-    f.read(reinterpret_cast<char*>(rgb.data() + static_cast<size_t>(y) * w * 3), sizeof(float) * w * 3);
-  }
-  if (!f) ADD_FAILURE() << path << ": short file";
-  return rgb;
-}
 
 struct Golden {
   const char* scene;
@@ -58,7 +37,7 @@ TEST_P(GoldenImage, IsBitIdentical) {
   o.params = RenderParams{w, h, 2, 8, 3, 11};
   o.wave_size = 1024;
   const RenderResult r = render(load_scene(test::repo_path(std::string("scenes/") + g.scene + ".json")), o);
-  const std::vector<float> expect = read_pfm(
+  const std::vector<float> expect = test::read_pfm(
       test::repo_path(std::string("tests/data/golden/") + g.scene + "_" + backend_name(g.backend) + ".pfm"), w, h);
   ASSERT_EQ(r.rgb.size(), expect.size());
   size_t differing = 0;

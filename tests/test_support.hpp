@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 namespace wt::test {
 
@@ -16,6 +17,10 @@ std::string repo_root();
 std::string repo_path(const std::string& relative);
 
 bool cuda_available();
+
+// A PFM as the command writes it (linear RGB, row 0 = top, as renders return it);
+// a failure is added to the test where the file is not a width x height PFM.
+std::vector<float> read_pfm(const std::string& path, int width, int height);
 
 }  // namespace wt::test
 

@@ -22,7 +22,7 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 // The keys of a job (and of "defaults"): the files, then every setting of the table.
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k = {"scene", "output", "stats", "backend", "kernel", "encoding"};
+    std::vector<std::string> k = {"scene", "output", "stats", "checkpoint", "resume", "backend", "kernel", "encoding"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -42,6 +42,10 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.output = relative_to(base, r.string(value, at));
     } else if (key == "stats") {
       job.stats = relative_to(base, r.string(value, at));
+    } else if (key == "checkpoint") {
+      job.checkpoint = relative_to(base, r.string(value, at));
+    } else if (key == "resume") {
+      job.resume = relative_to(base, r.string(value, at));
     } else if (key == "backend") {
       job.backend = backend_choices()[r.choice(value, at, backend_choices())];
     } else if (key == "kernel") {
@@ -91,19 +95,26 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
   return jobs;
 }
 
-int run_batch(const std::vector<PlannedJob>& jobs) {
+int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
   struct Row {
     std::string scene, settings, kernel, status;
     double seconds = 0, mrays = 0;
   };
   std::vector<Row> rows;
-  int failed = 0;
+  int failed = 0, interrupted = 0;
   for (size_t i = 0; i < jobs.size(); ++i) {
     const PlannedJob& pj = jobs[i];
     std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, jobs.size(), pj.job.scene.c_str());
     Row row;
     row.scene = pj.job.scene;
     row.kernel = pj.job.kernel;
+    // Images are written through a temporary file renamed into place: one that
+    // exists is complete.
+    if (skip_done && pj.error.empty() && std::filesystem::exists(pj.job.output)) {
+      row.status = "skipped: " + pj.job.output + " exists";
+      rows.push_back(row);
+      continue;
+    }
     JobOutcome o;
     if (!pj.error.empty()) {
       o.exit_code = kExitBadInput;
@@ -124,6 +135,11 @@ int run_batch(const std::vector<PlannedJob>& jobs) {
       row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
     }
     rows.push_back(row);
+    // A signal stopped the job (after its last checkpoint): the batch stops too.
+    if (o.exit_code >= 128) {
+      interrupted = o.exit_code;
+      break;
+    }
   }
   std::printf("%-4s %-32s %-22s %-26s %9s %10s  %s\n", "job", "scene", "settings", "backend/kernel", "seconds",
               "M rays/s", "result");
@@ -132,7 +148,10 @@ int run_batch(const std::vector<PlannedJob>& jobs) {
     std::printf("%-4zu %-32s %-22s %-26s %9.3f %10.2f  %s\n", i + 1, r.scene.c_str(), r.settings.c_str(),
                 r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
   }
-  std::printf("%zu jobs: %zu ok, %d failed\n", rows.size(), rows.size() - failed, failed);
+  std::printf("%zu jobs: %zu ok, %d failed", rows.size(), rows.size() - failed, failed);
+  if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - rows.size());
+  std::printf("\n");
+  if (interrupted) return interrupted;
   return failed ? kExitFailure : 0;
 }
 

@@ -20,6 +20,8 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
 bool is_jobs_file(const std::string& path);
 
 // Runs every job, prints a summary table, returns the exit code (non-zero if any failed).
-int run_batch(const std::vector<PlannedJob>& jobs);
+// `skip_done`: jobs whose image exists are skipped (a batch resumed). A job stopped
+// by a signal stops the batch, whose exit code is then the job's.
+int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
 
 }  // namespace wt::app

@@ -1,9 +1,16 @@
 #include "app/job.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 
+#include "app/checkpoint.hpp"
 #include "app/progress.hpp"
+#include "app/signals.hpp"
 #include "app/stats.hpp"
 #include "cuda/device.hpp"
 
@@ -47,6 +54,8 @@ void set_setting(Job& job, SettingId id, int64_t value) {
     job.wave_size = value;
   } else if (id == SettingId::Threads) {
     job.threads = value;
+  } else if (id == SettingId::CheckpointEvery) {
+    job.checkpoint_every = value;
   }
 }
 
@@ -105,14 +114,59 @@ JobOutcome run_job(const Job& job) {
     out.backend = backend_name(options.backend);
     out.kernel = kernel_name(options.kernel);
 
-    const uint64_t paths = static_cast<uint64_t>(options.params.width) * options.params.height * options.params.spp;
-    {
-      ProgressLine progress(paths);
+    const RenderParams& rp = options.params;
+    // Checkpoints go to job.checkpoint, or back into the file resumed from.
+    const std::string checkpoint_path = job.checkpoint.empty() ? job.resume : job.checkpoint;
+    Checkpoint resumed;
+    std::optional<SignalCatcher> signals;
+    if (!checkpoint_path.empty()) {
+      const CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
+      const std::string from =
+          !job.resume.empty() ? job.resume : (std::filesystem::exists(job.checkpoint) ? job.checkpoint : "");
+      if (!from.empty()) {
+        resumed = read_checkpoint(from);
+        require_same_render(from, resumed.identity, identity);
+        options.first_sample = resumed.samples;
+        options.initial_film = &resumed.film;
+        out.resumed_from_sample = resumed.samples;
+      }
+      // Short passes, so that a signal is answered within about 1/256 of the render.
+      options.samples_per_pass = std::max(1, rp.spp / 256);
+      signals.emplace();
+      auto last_write = std::chrono::steady_clock::now();
+      options.after_pass = [&, identity](int32_t samples, const FilmReader& film) {
+        const bool stop = signals->caught() != 0;
+        const auto now = std::chrono::steady_clock::now();
+        if (stop || (samples < rp.spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {
+          write_checkpoint(checkpoint_path, Checkpoint{identity, samples, film()});
+          last_write = now;
+        }
+        return !stop;
+      };
+    }
+
+    if (resumed.samples >= rp.spp && !resumed.film.empty()) {
+      // Every sample was done before: the image is the checkpoint's film.
+      out.result.rgb = resumed.film;
+      for (float& v : out.result.rgb) v /= static_cast<float>(rp.spp);
+      out.result.samples = rp.spp;
+    } else {
+      ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
       if (job.progress) options.progress = progress.callback();
       out.result = render(scene, options);
     }
+    if (out.result.interrupted) {
+      const int sig = signals->caught();
+      out.exit_code = 128 + sig;
+      out.message = std::string("interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") + " at sample " +
+                    std::to_string(out.result.samples) + " of " + std::to_string(rp.spp) +
+                    "; checkpoint written to " + checkpoint_path + " (resume with --resume " + checkpoint_path + ")";
+      return out;
+    }
     write_image(job.output, options.params.width, options.params.height, out.result.rgb, job.encoding);
     if (!job.stats.empty()) write_text_file(job.stats, stats_json(job, out).dump(2) + "\n");
+    // The image is written: the checkpoint has served its purpose.
+    if (!checkpoint_path.empty()) std::filesystem::remove(checkpoint_path);
     if (job.profile) {
       print_load_times(out.load_times, out.result.upload_seconds);
       print_profile(out.result);

@@ -23,12 +23,18 @@ struct Job {
   int64_t warmup = 0;
   int64_t wave_size = 0;  // 0: chosen at run time
   int64_t threads = 0;    // 0: every core
+  // Checkpoints (docs/checkpoints.md): written to `checkpoint` every
+  // `checkpoint_every` seconds and on SIGINT/SIGTERM; `resume` continues from one
+  // (an existing `checkpoint` file is resumed too, never overwritten by a new start).
+  std::string checkpoint, resume;
+  int64_t checkpoint_every = 300;
   Encoding encoding = Encoding::Srgb;
   bool progress = true;
   bool profile = false;
 };
 
-// Exit codes: bad input (scene, settings, paths) and failures of the machine.
+// Exit codes: bad input (scene, settings, paths) and failures of the machine; a
+// render stopped by a signal after its last checkpoint exits with 128 + the signal.
 constexpr int kExitBadInput = 2;
 constexpr int kExitFailure = 1;
 
@@ -37,6 +43,7 @@ struct JobOutcome {
   std::string message;  // the one line that says why, when exit_code != 0
   RenderParams params{};
   LoadTimes load_times;
+  int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
   std::string backend, kernel;
   RenderResult result;
 };

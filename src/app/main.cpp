@@ -47,6 +47,10 @@ int main(int argc, char** argv) {
   render->add_option("scene", job.scene, "scene file (JSON)")->required();
   render->add_option("-o,--output", job.output, "image file: .png (8-bit) or .pfm (linear float)")->required();
   render->add_option("--stats", job.stats, "write render statistics as JSON");
+  render->add_option("--checkpoint", job.checkpoint,
+                     "write the film's sums here every --checkpoint-every seconds and on SIGINT/SIGTERM; "
+                     "an existing checkpoint of the same render is resumed");
+  render->add_option("--resume", job.resume, "continue the render a checkpoint holds");
   render->add_flag("-q,--quiet", quiet, "no progress line");
   add_render_options(*render, job, encoding);
 
@@ -57,6 +61,8 @@ int main(int argc, char** argv) {
   CLI::App* batch = app.add_subcommand("batch", "render a jobs file, or several scene files");
   batch->add_option("inputs", inputs, "a jobs file ({\"jobs\": [...]}) or scene files")->required();
   batch->add_option("--output-dir", output_dir, "where scene files given directly are rendered to");
+  bool skip_done = false;
+  batch->add_flag("--resume", skip_done, "skip the jobs whose image exists (a batch resumed)");
   add_render_options(*batch, batch_job, batch_encoding);
 
   wt::app::BenchOptions bench_options;
@@ -133,5 +139,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     return wt::app::kExitBadInput;
   }
-  return wt::app::run_batch(jobs);
+  return wt::app::run_batch(jobs, skip_done);
 }

@@ -49,6 +49,7 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["kernel"] = o.kernel;
   j["device"] = r.device;
   j["seconds"] = r.seconds;
+  if (o.resumed_from_sample > 0) j["resumed_from_sample"] = o.resumed_from_sample;
   j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
   add_measurements(j, r, r.seconds, o.load_times);
   return j;

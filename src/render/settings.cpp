@@ -20,6 +20,8 @@ const std::vector<Setting>& settings() {
       {SettingId::WaveSize, "wave_size", "--wave-size", SettingType::Int64, kMinWaveSlots,
        static_cast<int64_t>(kMaxWaveSize), 0, "wavefront path slots (default: chosen from free memory)"},
       {SettingId::Threads, "threads", "--threads", SettingType::Int32, 1, 1024, 0, "CPU threads (default: all cores)"},
+      {SettingId::CheckpointEvery, "checkpoint_every", "--checkpoint-every", SettingType::Int32, 1, 30 * 24 * 3600,
+       300, "seconds between checkpoints (with --checkpoint)"},
   };
   return table;
 }

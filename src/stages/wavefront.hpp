@@ -57,7 +57,9 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const RenderParams& rp = options.params;
   const bool sorted = options.kernel == Kernel::Wavefront;
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
-  const std::vector<SamplePass> passes = plan_passes(options, 1);
+  // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
+  // ends with the wave draining, which a full wave's regeneration otherwise hides.
+  const std::vector<SamplePass> passes = plan_passes(options, 1, 4 * static_cast<uint64_t>(capacity));
   const uint64_t all_paths = pixels * static_cast<uint64_t>(passes.empty() ? 0 : passes.back().first +
                                                                                    passes.back().count - passes.front().first);
   const uint32_t slots = static_cast<uint32_t>(capacity);

@@ -1,0 +1,148 @@
+#include "app/checkpoint.hpp"
+
+#include <zlib.h>
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "image/image_io.hpp"
+#include "render/settings.hpp"
+#include "scene/scene.hpp"
+
+namespace wt::app {
+
+namespace {
+
+using nlohmann::json;
+
+constexpr char kMagic[8] = {'W', 'T', 'C', 'K', 'P', 'T', '\r', '\n'};
+
+uint32_t crc_of(const char* data, size_t bytes) {
+  uLong crc = crc32(0L, Z_NULL, 0);
+  while (bytes > 0) {
+    const uInt chunk = static_cast<uInt>(std::min<size_t>(bytes, 1u << 30));
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(data), chunk);
+    data += chunk;
+    bytes -= chunk;
+  }
+  return static_cast<uint32_t>(crc);
+}
+
+template <class T>
+void put(std::string& out, T value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+json identity_json(const CheckpointIdentity& id) {
+  json settings = json::object();
+  for (SettingId s : render_settings()) settings[setting(s).key] = get_param(id.params, s);
+  return {{"scene", id.scene},   {"scene_crc32", id.scene_crc}, {"settings", settings},
+          {"kernel", id.kernel}, {"backend", id.backend},       {"renderer", id.renderer}};
+}
+
+[[noreturn]] void damaged(const std::string& path, const std::string& what) {
+  throw SceneError(path + ": not a usable checkpoint: " + what);
+}
+
+}  // namespace
+
+CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
+                                       const std::string& kernel, const std::string& backend) {
+  std::ifstream f(scene, std::ios::binary);
+  if (!f) throw SceneError(scene + ": cannot open scene file");
+  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  CheckpointIdentity id;
+  id.scene = scene;
+  id.scene_crc = crc_of(bytes.data(), bytes.size());
+  id.params = params;
+  id.kernel = kernel;
+  id.backend = backend;
+  return id;
+}
+
+// Layout (little-endian): magic, u32 format, u32 header length, the header (JSON:
+// identity and samples), u64 float count, the film's floats, u32 CRC-32 of all before.
+void write_checkpoint(const std::string& path, const Checkpoint& c) {
+  json header = identity_json(c.identity);
+  header["samples"] = c.samples;
+  const std::string text = header.dump();
+  std::string out(kMagic, sizeof kMagic);
+  put<uint32_t>(out, kCheckpointFormat);
+  put<uint32_t>(out, static_cast<uint32_t>(text.size()));
+  out += text;
+  put<uint64_t>(out, c.film.size());
+  out.append(reinterpret_cast<const char*>(c.film.data()), c.film.size() * sizeof(float));
+  put<uint32_t>(out, crc_of(out.data(), out.size()));
+  write_text_file(path, out);  // written through a temporary file renamed into place
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw SceneError(path + ": cannot open checkpoint");
+  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const size_t fixed = sizeof kMagic + 2 * sizeof(uint32_t);
+  if (bytes.size() < fixed + sizeof(uint64_t) + sizeof(uint32_t) ||
+      std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
+    damaged(path, "it does not start as a wavetrace checkpoint does");
+  }
+  uint32_t stored_crc = 0;
+  std::memcpy(&stored_crc, bytes.data() + bytes.size() - sizeof stored_crc, sizeof stored_crc);
+  if (crc_of(bytes.data(), bytes.size() - sizeof stored_crc) != stored_crc) {
+    damaged(path, "its checksum does not match (the file is damaged or was cut short)");
+  }
+  uint32_t format = 0, header_bytes = 0;
+  std::memcpy(&format, bytes.data() + sizeof kMagic, sizeof format);
+  std::memcpy(&header_bytes, bytes.data() + sizeof kMagic + sizeof format, sizeof header_bytes);
+  if (format != kCheckpointFormat) {
+    damaged(path, "format version " + std::to_string(format) + "; this wavetrace reads version " +
+                      std::to_string(kCheckpointFormat));
+  }
+  if (fixed + header_bytes + sizeof(uint64_t) + sizeof(uint32_t) > bytes.size()) damaged(path, "its header is cut short");
+  Checkpoint c;
+  try {
+    const json header = json::parse(bytes.substr(fixed, header_bytes));
+    c.identity.scene = header.at("scene").get<std::string>();
+    c.identity.scene_crc = header.at("scene_crc32").get<uint32_t>();
+    for (SettingId s : render_settings()) set_param(c.identity.params, s, header.at("settings").at(setting(s).key).get<int64_t>());
+    c.identity.kernel = header.at("kernel").get<std::string>();
+    c.identity.backend = header.at("backend").get<std::string>();
+    c.identity.renderer = header.at("renderer").get<std::string>();
+    c.samples = header.at("samples").get<int32_t>();
+  } catch (const nlohmann::json::exception& e) {
+    damaged(path, std::string("its header cannot be read (") + e.what() + ")");
+  }
+  uint64_t floats = 0;
+  const size_t at = fixed + header_bytes;
+  std::memcpy(&floats, bytes.data() + at, sizeof floats);
+  if (at + sizeof floats + floats * sizeof(float) + sizeof(uint32_t) != bytes.size()) {
+    damaged(path, "its film is not the size its header says");
+  }
+  c.film.resize(floats);
+  std::memcpy(c.film.data(), bytes.data() + at + sizeof floats, floats * sizeof(float));
+  return c;
+}
+
+void require_same_render(const std::string& path, const CheckpointIdentity& then, const CheckpointIdentity& now) {
+  auto refuse = [&](const std::string& what) {
+    throw SceneError(path + ": the checkpoint is of another render: " + what);
+  };
+  if (then.renderer != now.renderer) refuse("made by " + then.renderer + ", this is " + now.renderer);
+  if (then.scene_crc != now.scene_crc) {
+    refuse("scene " + then.scene + " (CRC-32 " + std::to_string(then.scene_crc) + "), not " + now.scene +
+           " as it is now (CRC-32 " + std::to_string(now.scene_crc) + ")");
+  }
+  for (SettingId s : render_settings()) {
+    const int64_t a = get_param(then.params, s), b = get_param(now.params, s);
+    if (a != b) {
+      refuse(std::string(setting(s).key) + " " + std::to_string(a) + " in the checkpoint, " + std::to_string(b) +
+             " now");
+    }
+  }
+  if (then.kernel != now.kernel || then.backend != now.backend) {
+    refuse(then.backend + "/" + then.kernel + " in the checkpoint, " + now.backend + "/" + now.kernel + " now");
+  }
+}
+
+}  // namespace wt::app

@@ -1,0 +1,49 @@
+// Checkpoints: a render's film sums and the samples done, written atomically while
+// the render runs, so that it can be resumed after an interruption and give the
+// image an uninterrupted render gives. The format: docs/checkpoints.md.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "render/render_types.hpp"
+
+namespace wt::app {
+
+constexpr uint32_t kCheckpointFormat = 1;
+
+// What a checkpoint must match to be resumed: the scene file's bytes, the render's
+// settings, the kernel and backend, and the renderer's version.
+struct CheckpointIdentity {
+  std::string scene;         // the scene file, as given
+  uint32_t scene_crc = 0;    // CRC-32 of its bytes
+  RenderParams params{};
+  std::string kernel, backend;
+  std::string renderer = kRendererVersion;
+
+  static constexpr const char* kRendererVersion = "wavetrace 0.3 (light transport of 2026-11)";
+};
+
+// Reads the scene file and fills the identity; throws SceneError if it cannot be read.
+CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
+                                       const std::string& kernel, const std::string& backend);
+
+struct Checkpoint {
+  CheckpointIdentity identity;
+  int32_t samples = 0;       // samples of every pixel the film sums, from sample 0
+  std::vector<float> film;   // linear RGB sums per pixel, row 0 = top
+};
+
+// Writes atomically (temporary file renamed into place); throws OutputError.
+void write_checkpoint(const std::string& path, const Checkpoint& checkpoint);
+
+// Reads and checks the checksum and the format; throws SceneError naming the file
+// and what is wrong.
+Checkpoint read_checkpoint(const std::string& path);
+
+// Throws SceneError naming the file and the first thing that differs.
+void require_same_render(const std::string& path, const CheckpointIdentity& checkpoint,
+                         const CheckpointIdentity& now);
+
+}  // namespace wt::app

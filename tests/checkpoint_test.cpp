@@ -1,0 +1,208 @@
+// Checkpoints: the file round-trips, a damaged or foreign one is refused with one
+// line, and a render stopped by a signal resumes to the image it would have made.
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "app/batch.hpp"
+#include "app/checkpoint.hpp"
+#include "app/job.hpp"
+#include "test_support.hpp"
+
+namespace wt::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CheckpointTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("wavetrace_checkpoint_test_" + std::to_string(::getpid()) + "_" +
+                                        testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    scene_ = test::repo_path("scenes/quick.json");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  Checkpoint sample_checkpoint() const {
+    Checkpoint c;
+    c.identity = checkpoint_identity(scene_, RenderParams{4, 2, 16, 8, 3, 7}, "wavefront", "cpu");
+    c.samples = 5;
+    for (int i = 0; i < 4 * 2 * 3; ++i) c.film.push_back(0.25f * i);
+    return c;
+  }
+
+  std::string bytes_of(const std::string& file) const {
+    std::ifstream f(file, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  }
+
+  void write_bytes(const std::string& file, const std::string& bytes) const {
+    std::ofstream(file, std::ios::binary) << bytes;
+  }
+
+  std::string refusal(const std::string& file) const {
+    try {
+      read_checkpoint(file);
+    } catch (const SceneError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+
+  // A job on the CPU whose render runs in several passes: a wave of 1024 slots
+  // makes passes of at least 4096 paths, 16 samples of 16 x 16 pixels, of 64.
+  Job job(const std::string& output) const {
+    Job j;
+    j.scene = scene_;
+    j.output = output;
+    j.width = 16;
+    j.height = 16;
+    j.spp = 64;
+    j.depth = 6;
+    j.backend = "cpu";
+    j.kernel = "wavefront";
+    j.wave_size = 1024;
+    j.progress = false;
+    return j;
+  }
+
+  fs::path dir_;
+  std::string scene_;
+};
+
+TEST_F(CheckpointTest, RoundTripsWhatItHolds) {
+  const Checkpoint c = sample_checkpoint();
+  write_checkpoint(path("c.ckpt"), c);
+  const Checkpoint back = read_checkpoint(path("c.ckpt"));
+  EXPECT_EQ(back.samples, 5);
+  EXPECT_EQ(back.film, c.film);
+  EXPECT_NO_THROW(require_same_render(path("c.ckpt"), back.identity, c.identity));
+  EXPECT_EQ(back.identity.scene_crc, c.identity.scene_crc);
+}
+
+TEST_F(CheckpointTest, ADamagedOrCutOrForeignFileIsRefused) {
+  write_checkpoint(path("c.ckpt"), sample_checkpoint());
+  std::string bytes = bytes_of(path("c.ckpt"));
+
+  std::string flipped = bytes;
+  flipped[flipped.size() - 20] ^= 0x40;  // a bit of the film
+  write_bytes(path("flipped.ckpt"), flipped);
+  EXPECT_EQ(refusal(path("flipped.ckpt")), path("flipped.ckpt") + ": not a usable checkpoint: its checksum does "
+                                                                  "not match (the file is damaged or was cut short)");
+
+  write_bytes(path("cut.ckpt"), bytes.substr(0, bytes.size() / 2));
+  EXPECT_NE(refusal(path("cut.ckpt")).find("checksum does not match"), std::string::npos);
+
+  write_bytes(path("other.ckpt"), "{\"jobs\": []}");
+  EXPECT_EQ(refusal(path("other.ckpt")),
+            path("other.ckpt") + ": not a usable checkpoint: it does not start as a wavetrace checkpoint does");
+
+  // A later format, with its checksum made good: refused by its version.
+  std::string later = bytes.substr(0, bytes.size() - 4);
+  const uint32_t version = kCheckpointFormat + 1;
+  std::memcpy(&later[8], &version, sizeof version);
+  const uint32_t crc = static_cast<uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(later.data()), later.size()));
+  later.append(reinterpret_cast<const char*>(&crc), sizeof crc);
+  write_bytes(path("later.ckpt"), later);
+  EXPECT_EQ(refusal(path("later.ckpt")), path("later.ckpt") + ": not a usable checkpoint: format version " +
+                                             std::to_string(version) + "; this wavetrace reads version " +
+                                             std::to_string(kCheckpointFormat));
+
+  EXPECT_EQ(refusal(path("missing.ckpt")), path("missing.ckpt") + ": cannot open checkpoint");
+}
+
+TEST_F(CheckpointTest, AnotherSceneSettingsOrKernelIsRefused) {
+  const CheckpointIdentity then = sample_checkpoint().identity;
+  auto refusal_of = [&](const CheckpointIdentity& now) {
+    try {
+      require_same_render("c.ckpt", then, now);
+    } catch (const SceneError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CheckpointIdentity now = then;
+  now.params.spp = 32;
+  EXPECT_EQ(refusal_of(now), "c.ckpt: the checkpoint is of another render: spp 16 in the checkpoint, 32 now");
+  now = then;
+  now.kernel = "megakernel";
+  EXPECT_EQ(refusal_of(now),
+            "c.ckpt: the checkpoint is of another render: cpu/wavefront in the checkpoint, cpu/megakernel now");
+  now = then;
+  now.scene_crc ^= 1;
+  EXPECT_NE(refusal_of(now).find("the checkpoint is of another render: scene "), std::string::npos);
+  now = then;
+  now.renderer = "wavetrace 0.1";
+  EXPECT_NE(refusal_of(now).find("made by " + then.renderer), std::string::npos);
+}
+
+TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
+  const JobOutcome whole = run_job(job(path("whole.pfm")));
+  ASSERT_EQ(whole.exit_code, 0) << whole.message;
+
+  // A SIGTERM is pending (blocked) when the render starts: the job's catcher takes
+  // it, so the render stops after its first pass with a last checkpoint.
+  Job first = job(path("resumed.pfm"));
+  first.checkpoint = path("r.ckpt");
+  sigset_t term, previous;
+  sigemptyset(&term);
+  sigaddset(&term, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &term, &previous);
+  ::kill(::getpid(), SIGTERM);
+  const JobOutcome stopped = run_job(first);
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  EXPECT_EQ(stopped.exit_code, 128 + SIGTERM);
+  EXPECT_EQ(stopped.message, "interrupted by SIGTERM at sample 16 of 64; checkpoint written to " + path("r.ckpt") +
+                                 " (resume with --resume " + path("r.ckpt") + ")");
+  EXPECT_FALSE(fs::exists(path("resumed.pfm")));
+  ASSERT_TRUE(fs::exists(path("r.ckpt")));
+  EXPECT_EQ(read_checkpoint(path("r.ckpt")).samples, 16);
+
+  Job rest = job(path("resumed.pfm"));
+  rest.resume = path("r.ckpt");
+  const JobOutcome resumed = run_job(rest);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.message;
+  EXPECT_EQ(resumed.resumed_from_sample, 16);
+  EXPECT_FALSE(fs::exists(path("r.ckpt")));  // the image is written: the checkpoint is done with
+  EXPECT_EQ(stopped.result.rays + resumed.result.rays, whole.result.rays);
+  const auto a = test::read_pfm(path("whole.pfm"), 16, 16), b = test::read_pfm(path("resumed.pfm"), 16, 16);
+  ASSERT_EQ(a.size(), b.size());
+  // The same samples summed in another grouping: equal to float rounding.
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-5f * std::max(1.0f, a[i])) << i;
+}
+
+TEST_F(CheckpointTest, AnExistingCheckpointOfAnotherRenderIsNeverOverwritten) {
+  write_checkpoint(path("c.ckpt"), sample_checkpoint());
+  const std::string before = bytes_of(path("c.ckpt"));
+  Job j = job(path("out.pfm"));
+  j.checkpoint = path("c.ckpt");
+  const JobOutcome o = run_job(j);
+  EXPECT_EQ(o.exit_code, kExitBadInput);
+  EXPECT_NE(o.message.find(path("c.ckpt") + ": the checkpoint is of another render: width 4 in the checkpoint, "
+                                            "16 now"),
+            std::string::npos)
+      << o.message;
+  EXPECT_EQ(bytes_of(path("c.ckpt")), before);
+  EXPECT_FALSE(fs::exists(path("out.pfm")));
+}
+
+TEST_F(CheckpointTest, AResumedBatchSkipsTheJobsWhoseImageExists) {
+  std::vector<PlannedJob> jobs = {{job(path("a.pfm")), ""}, {job(path("b.pfm")), ""}};
+  write_bytes(path("a.pfm"), "an image from before");
+  EXPECT_EQ(run_batch(jobs, true), 0);
+  EXPECT_EQ(bytes_of(path("a.pfm")), "an image from before");
+  EXPECT_TRUE(fs::exists(path("b.pfm")));
+}
+
+}  // namespace
+}  // namespace wt::app
