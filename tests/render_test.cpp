@@ -137,7 +137,10 @@ TEST_P(EveryKernel, PassesOverThePathLimitTraceTheSamePaths) {
 // the same paths, the same image as the render that ran through.
 TEST_P(EveryKernel, AStoppedRenderResumedFromItsFilmEqualsTheWholeRender) {
   const Scene scene = load_scene(test::repo_path("scenes/quick.json"));
-  RenderOptions whole = options_for(GetParam().backend, GetParam().kernel, 24, 16, 12, 8, 3, 5);
+  // 64 x 64 pixels: with a wave of 1024 slots, the wavefront's passes of at least
+  // four waves' paths are one sample, so the four samples asked for a pass hold.
+  RenderOptions whole = options_for(GetParam().backend, GetParam().kernel, 64, 64, 12, 8, 3, 5);
+  whole.wave_size = 1024;
   whole.samples_per_pass = 4;
   const RenderResult a = render(scene, whole);
 
