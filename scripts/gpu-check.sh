@@ -3,10 +3,18 @@
 # binary in the folder, then a short render of the reference scene with each GPU
 # kernel; prints one summary line. Run from anywhere; test data is found relative
 # to the repository root, and nothing here depends on paths of the build machine.
-#   scripts/gpu-check.sh BIN_DIR [OUT_DIR]
+# With --sanitize it then runs every test binary and a short render of each GPU
+# kernel under compute-sanitizer's memcheck, racecheck, synccheck and initcheck,
+# and fails on any error they report.
+#   scripts/gpu-check.sh [--sanitize] BIN_DIR [OUT_DIR]
 set -uo pipefail
+sanitize=0
+if [[ "${1:-}" == --sanitize ]]; then
+  sanitize=1
+  shift
+fi
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-bin=$(cd "${1:?usage: gpu-check.sh BIN_DIR [OUT_DIR]}" && pwd)
+bin=$(cd "${1:?usage: gpu-check.sh [--sanitize] BIN_DIR [OUT_DIR]}" && pwd)
 out=${2:-$root/out/gpu-check}
 mkdir -p "$out"
 cd "$root"
@@ -40,5 +48,34 @@ for kernel in $kernels; do
   fi
 done
 
-echo "gpu-check: ${passed} passed, ${failed} failed, ${skipped} skipped; renders: ${renders} ok, ${render_failed} failed${broken:+; failing binaries: ${broken[*]}}"
-((failed == 0 && render_failed == 0 && ${#broken[@]} == 0))
+sanitized="" sanitizer_errors=0 n=0
+if ((sanitize)); then
+  for tool in memcheck racecheck synccheck initcheck; do
+    errors=0
+    runs=()
+    for t in "$bin"/*_tests; do
+      [[ -x "$t" ]] && runs+=("$t --gtest_brief=1")
+    done
+    for kernel in $kernels; do
+      runs+=("$bin/wavetrace render scenes/seed57.json -o $out/sanitize-$kernel.png --width 160 --height 90 --spp 4 --backend cuda --kernel $kernel -q")
+    done
+    for run in "${runs[@]}"; do
+      log="$out/sanitize-$tool-$(basename "${run%% *}")-$((++n)).log"
+      # shellcheck disable=SC2086
+      compute-sanitizer --tool "$tool" --error-exitcode 99 $run >"$log" 2>&1
+      rc=$?
+      e=$(grep -oP 'ERROR SUMMARY: \K[0-9]+' "$log" | tail -1)
+      if [[ -z "$e" ]] || ((rc == 99)); then
+        e=${e:-1}
+        echo "sanitize $tool: $run: $(grep -m3 -E '^========= (Invalid|Uninitialized|Race|Barrier|Error|Program hit)' "$log" | tr '\n' ' ')"
+      fi
+      errors=$((errors + e))
+    done
+    sanitized+="${sanitized:+, }$tool $errors"
+    sanitizer_errors=$((sanitizer_errors + errors))
+  done
+  sanitized="; compute-sanitizer errors: $sanitized"
+fi
+
+echo "gpu-check: ${passed} passed, ${failed} failed, ${skipped} skipped; renders: ${renders} ok, ${render_failed} failed${broken:+; failing binaries: ${broken[*]}}${sanitized}"
+((failed == 0 && render_failed == 0 && ${#broken[@]} == 0 && sanitizer_errors == 0))
