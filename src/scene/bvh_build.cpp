@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <thread>
 
 #include "scene/scene.hpp"
 
@@ -52,28 +53,29 @@ struct Split {
   double cost = DBL_MAX;
 };
 
+// A sphere as the builder moves it: partitions permute these records in place, so
+// every pass over a node's range reads contiguous memory.
+struct Item {
+  Box bounds;
+  vec3 centroid;
+  uint32_t sphere;
+};
+
+// Subtrees of at least this many spheres are built on a thread of their own, down
+// to the depth that gives every core one.
+constexpr int kParallelMinCount = 1 << 15;
+
 class Builder {
  public:
-  Builder(const std::vector<SphereGeom>& spheres, std::vector<BvhNode>& nodes) : nodes_(nodes) {
-    for (const SphereGeom& s : spheres) {
-      vec3 c(s.x, s.y, s.z);
-      // The slab test and the sphere test round differently; a box a little larger
-      // than the sphere keeps a grazing hit from being culled by its own box.
-      float pad = 1e-5f * (std::max({std::fabs(s.x), std::fabs(s.y), std::fabs(s.z)}) + s.w);
-      Box b;
-      b.lo = c - vec3(s.w + pad);
-      b.hi = c + vec3(s.w + pad);
-      bounds_.push_back(b);
-      centroid_.push_back(c);
-      order_.push_back(static_cast<uint32_t>(order_.size()));
-    }
-  }
+  // Builds the subtree of items [first, first + count) into `nodes`, its root at `node`.
+  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes, int parallel_depth)
+      : items_(items), nodes_(nodes), parallel_depth_(parallel_depth) {}
 
   void build(int node, int first, int count, int depth) {
     Box box, centroids;
     for (int i = first; i < first + count; ++i) {
-      box.grow(bounds_[order_[i]]);
-      centroids.grow(centroid_[order_[i]]);
+      box.grow(items_[i].bounds);
+      centroids.grow(items_[i].centroid);
     }
     BvhNode& n = nodes_[node];
     for (int k = 0; k < 3; ++k) {
@@ -98,16 +100,37 @@ class Builder {
     nodes_[node].left_or_first = left;
     nodes_[node].count = 0;
     nodes_.resize(nodes_.size() + 2);
-    build(left, first, left_count, depth + 1);
-    build(left + 1, first + left_count, count - left_count, depth + 1);
+    if (depth < parallel_depth_ && count - left_count >= kParallelMinCount) {
+      // The right subtree into nodes of its own, meanwhile the left one here; then
+      // the right one's nodes follow the left one's, as a serial build lays them out.
+      std::vector<BvhNode> right_nodes(1);
+      right_nodes.reserve(2 * (count - left_count));
+      Builder right(items_, right_nodes, parallel_depth_);
+      std::thread worker([&] { right.build(0, first + left_count, count - left_count, depth + 1); });
+      build(left, first, left_count, depth + 1);
+      worker.join();
+      append_subtree(left + 1, right_nodes);
+    } else {
+      build(left, first, left_count, depth + 1);
+      build(left + 1, first + left_count, count - left_count, depth + 1);
+    }
   }
 
-  const std::vector<uint32_t>& order() const { return order_; }
-
  private:
-  int bin_of(uint32_t sphere, const Box& centroids, int axis) const {
+  // Places a subtree built on its own: its root at `root`, the rest appended.
+  void append_subtree(int root, const std::vector<BvhNode>& sub) {
+    const int base = static_cast<int>(nodes_.size()) - 1;  // sub's node i >= 1 goes to base + i
+    auto placed = [&](BvhNode n) {
+      if (n.count == 0) n.left_or_first += base;
+      return n;
+    };
+    nodes_[root] = placed(sub[0]);
+    for (size_t i = 1; i < sub.size(); ++i) nodes_.push_back(placed(sub[i]));
+  }
+
+  int bin_of(const Item& item, const Box& centroids, int axis) const {
     float extent = centroids.hi[axis] - centroids.lo[axis];
-    int b = static_cast<int>((centroid_[sphere][axis] - centroids.lo[axis]) / extent * kBins);
+    int b = static_cast<int>((item.centroid[axis] - centroids.lo[axis]) / extent * kBins);
     return std::min(std::max(b, 0), kBins - 1);
   }
 
@@ -120,8 +143,8 @@ class Builder {
       Box bin_box[kBins];
       int bin_count[kBins] = {};
       for (int i = first; i < first + count; ++i) {
-        int b = bin_of(order_[i], centroids, axis);
-        bin_box[b].grow(bounds_[order_[i]]);
+        int b = bin_of(items_[i], centroids, axis);
+        bin_box[b].grow(items_[i].bounds);
         ++bin_count[b];
       }
       // right_cost[b]: cost of the bins from b on.
@@ -147,9 +170,9 @@ class Builder {
   }
 
   int partition(int first, int count, const Box& centroids, const Split& split) {
-    auto begin = order_.begin() + first;
+    auto begin = items_.begin() + first;
     auto mid = std::partition(begin, begin + count,
-                              [&](uint32_t s) { return bin_of(s, centroids, split.axis) < split.bin; });
+                              [&](const Item& item) { return bin_of(item, centroids, split.axis) < split.bin; });
     return static_cast<int>(mid - begin);
   }
 
@@ -158,16 +181,15 @@ class Builder {
   int median(int first, int count, const Box& centroids) {
     vec3 extent = centroids.hi - centroids.lo;
     int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
-    auto begin = order_.begin() + first;
+    auto begin = items_.begin() + first;
     std::nth_element(begin, begin + count / 2, begin + count,
-                     [&](uint32_t a, uint32_t b) { return centroid_[a][axis] < centroid_[b][axis]; });
+                     [&](const Item& a, const Item& b) { return a.centroid[axis] < b.centroid[axis]; });
     return count / 2;
   }
 
+  std::vector<Item>& items_;
   std::vector<BvhNode>& nodes_;
-  std::vector<Box> bounds_;
-  std::vector<vec3> centroid_;
-  std::vector<uint32_t> order_;
+  int parallel_depth_;
 };
 
 }  // namespace
@@ -182,16 +204,29 @@ void build_bvh(Scene& scene) {
     throw SceneError(scene.source + ": /spheres: too many spheres for the BVH (" + std::to_string(count) + ")");
   }
 
-  Builder builder(scene.spheres, scene.nodes);
+  std::vector<Item> items(count);
+  for (size_t i = 0; i < count; ++i) {
+    const SphereGeom& s = scene.spheres[i];
+    vec3 c(s.x, s.y, s.z);
+    // The slab test and the sphere test round differently; a box a little larger
+    // than the sphere keeps a grazing hit from being culled by its own box.
+    float pad = 1e-5f * (std::max({std::fabs(s.x), std::fabs(s.y), std::fabs(s.z)}) + s.w);
+    items[i].bounds.lo = c - vec3(s.w + pad);
+    items[i].bounds.hi = c + vec3(s.w + pad);
+    items[i].centroid = c;
+    items[i].sphere = static_cast<uint32_t>(i);
+  }
+  int parallel_depth = 0;
+  for (unsigned cores = std::thread::hardware_concurrency(); (1u << parallel_depth) < cores;) ++parallel_depth;
   scene.nodes.reserve(2 * count);
   scene.nodes.resize(1);
-  builder.build(0, 0, static_cast<int>(count), 0);
+  Builder(items, scene.nodes, parallel_depth).build(0, 0, static_cast<int>(count), 0);
 
   std::vector<SphereGeom> spheres(count);
   std::vector<uint32_t> materials(count);
   for (size_t i = 0; i < count; ++i) {
-    spheres[i] = scene.spheres[builder.order()[i]];
-    materials[i] = scene.sphere_material[builder.order()[i]];
+    spheres[i] = scene.spheres[items[i].sphere];
+    materials[i] = scene.sphere_material[items[i].sphere];
   }
   scene.spheres = std::move(spheres);
   scene.sphere_material = std::move(materials);
