@@ -53,8 +53,10 @@ if ((sanitize)); then
   for tool in memcheck racecheck synccheck initcheck; do
     errors=0
     runs=()
+    # The test that sends itself SIGTERM is left out: compute-sanitizer takes the
+    # signal for its own and ends the run.
     for t in "$bin"/*_tests; do
-      [[ -x "$t" ]] && runs+=("$t --gtest_brief=1")
+      [[ -x "$t" ]] && runs+=("$t --gtest_brief=1 --gtest_filter=-*Sigterm*")
     done
     for kernel in $kernels; do
       runs+=("$bin/wavetrace render scenes/seed57.json -o $out/sanitize-$kernel.png --width 160 --height 90 --spp 4 --backend cuda --kernel $kernel -q")
@@ -64,7 +66,8 @@ if ((sanitize)); then
       # shellcheck disable=SC2086
       compute-sanitizer --tool "$tool" --error-exitcode 99 $run >"$log" 2>&1
       rc=$?
-      e=$(grep -oP 'ERROR SUMMARY: \K[0-9]+' "$log" | tail -1)
+      # racecheck sums up as "RACECHECK SUMMARY: N hazards displayed (E errors, W warnings)".
+      e=$(grep -oP '(ERROR SUMMARY: \K[0-9]+|RACECHECK SUMMARY: .*\(\K[0-9]+(?= errors))' "$log" | tail -1)
       if [[ -z "$e" ]] || ((rc == 99)); then
         e=${e:-1}
         echo "sanitize $tool: $run: $(grep -m3 -E '^========= (Invalid|Uninitialized|Race|Barrier|Error|Program hit)' "$log" | tr '\n' ' ')"
