@@ -1,5 +1,9 @@
 #include "test_support.hpp"
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 
@@ -20,5 +24,42 @@ std::string repo_root() {
 std::string repo_path(const std::string& relative) { return repo_root() + "/" + relative; }
 
 bool cuda_available() { return wt::cuda::device_count() > 0; }
+
+std::string in_child_process(const std::function<std::string()>& fn) {
+  int fds[2];
+  if (::pipe(fds) != 0) return "child process failed: pipe";
+  const pid_t pid = ::fork();
+  if (pid < 0) return "child process failed: fork";
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::string text;
+    try {
+      text = fn();
+    } catch (const std::exception& e) {
+      text = std::string("child process failed: threw ") + e.what();
+    }
+    for (size_t done = 0; done < text.size();) {
+      const ssize_t k = ::write(fds[1], text.data() + done, text.size() - done);
+      if (k <= 0) ::_exit(3);
+      done += static_cast<size_t>(k);
+    }
+    ::_exit(0);  // no atexit handlers or gtest teardown in the child
+  }
+  ::close(fds[1]);
+  std::string text;
+  char buf[4096];
+  for (ssize_t k; (k = ::read(fds[0], buf, sizeof buf)) != 0;) {
+    if (k > 0) text.append(buf, static_cast<size_t>(k));
+    else if (errno != EINTR) break;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return "child process failed: status " + std::to_string(status) + " after \"" + text + "\"";
+  }
+  return text;
+}
 
 }  // namespace wt::test

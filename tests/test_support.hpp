@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 
 namespace wt::test {
@@ -16,6 +17,11 @@ std::string repo_root();
 std::string repo_path(const std::string& relative);
 
 bool cuda_available();
+
+// Runs fn in a child process (fork) and returns what it returned, so that a test can
+// put limits on the child (RLIMIT_FSIZE, RLIMIT_AS) that the test process keeps
+// clear of. A child that dies or exits otherwise gives "child process failed: ...".
+std::string in_child_process(const std::function<std::string()>& fn);
 
 }  // namespace wt::test
 
