@@ -3,10 +3,8 @@
 // part way (a full disk) leave no file and no temporary file behind.
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
-#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -59,15 +57,12 @@ TEST(PngRoundTrip, Gamma2IsTheSquareRoot) {
   EXPECT_EQ(round_trip(rgb, 1, 2, Encoding::Gamma2), expected);
 }
 
-// A disk that fills up, for real and unprivileged: in a child process whose files may
-// not grow past `limit` bytes (RLIMIT_FSIZE, with SIGXFSZ ignored), a write past it
-// fails with EFBIG as a write to a full disk fails with ENOSPC. Returns the
-// OutputWriteError's message, or what happened instead.
-std::string write_error_with_file_size_limit(rlim_t limit, const std::function<void()>& write) {
+// The write run in a child process whose files may not grow past `limit` bytes (a
+// full disk: test::limit_file_size). Returns the OutputWriteError's message, or what
+// happened instead.
+std::string write_error_with_file_size_limit(unsigned long long limit, const std::function<void()>& write) {
   return test::in_child_process([&]() -> std::string {
-    std::signal(SIGXFSZ, SIG_IGN);
-    const rlimit r{limit, limit};
-    if (::setrlimit(RLIMIT_FSIZE, &r) != 0) return "setrlimit failed";
+    if (!test::limit_file_size(limit)) return "setrlimit failed";
     try {
       write();
     } catch (const OutputWriteError& e) {

@@ -1,9 +1,11 @@
 #include "test_support.hpp"
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 
@@ -60,6 +62,12 @@ std::string in_child_process(const std::function<std::string()>& fn) {
     return "child process failed: status " + std::to_string(status) + " after \"" + text + "\"";
   }
   return text;
+}
+
+bool limit_file_size(unsigned long long bytes) {
+  std::signal(SIGXFSZ, SIG_IGN);
+  const rlimit r{static_cast<rlim_t>(bytes), static_cast<rlim_t>(bytes)};
+  return ::setrlimit(RLIMIT_FSIZE, &r) == 0;
 }
 
 }  // namespace wt::test

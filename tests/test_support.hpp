@@ -23,6 +23,11 @@ bool cuda_available();
 // clear of. A child that dies or exits otherwise gives "child process failed: ...".
 std::string in_child_process(const std::function<std::string()>& fn);
 
+// In such a child: a disk that fills up, for real and unprivileged. Files may not grow
+// past `bytes` (RLIMIT_FSIZE) and SIGXFSZ is ignored, so a write past the limit fails
+// with EFBIG, as a write to a full disk fails with ENOSPC. False if it cannot be set.
+bool limit_file_size(unsigned long long bytes);
+
 }  // namespace wt::test
 
 // GPU tests skip (and say so) where no CUDA device is present.

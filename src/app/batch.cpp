@@ -97,7 +97,7 @@ int run_batch(const std::vector<PlannedJob>& jobs) {
     double seconds = 0, mrays = 0;
   };
   std::vector<Row> rows;
-  int failed = 0;
+  int failed = 0, resets = 0;
   for (size_t i = 0; i < jobs.size(); ++i) {
     const PlannedJob& pj = jobs[i];
     std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, jobs.size(), pj.job.scene.c_str());
@@ -113,6 +113,7 @@ int run_batch(const std::vector<PlannedJob>& jobs) {
     }
     if (o.exit_code != 0) {
       ++failed;
+      resets += o.device_reset;
       row.status = "FAILED: " + o.message;
       std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
     } else {
@@ -132,7 +133,8 @@ int run_batch(const std::vector<PlannedJob>& jobs) {
     std::printf("%-4zu %-32s %-22s %-26s %9.3f %10.2f  %s\n", i + 1, r.scene.c_str(), r.settings.c_str(),
                 r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
   }
-  std::printf("%zu jobs: %zu ok, %d failed\n", rows.size(), rows.size() - failed, failed);
+  std::printf("%zu jobs: %zu ok, %d failed", rows.size(), rows.size() - failed, failed);
+  std::printf(resets ? " (the device was reset after %d of them)\n" : "\n", resets);
   return failed ? kExitFailure : 0;
 }
 
