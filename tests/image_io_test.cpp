@@ -1,13 +1,19 @@
 // PNG encoding round trip: the project's writer encodes, stb decodes, and each
-// 8-bit value is the one the transfer curve gives, at its pixel.
+// 8-bit value is the one the transfer curve gives, at its pixel. Writes that fail
+// part way (a full disk) leave no file and no temporary file behind.
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
 #include <vector>
 
 #include "image/image_io.hpp"
+#include "test_support.hpp"
 
 namespace wt {
 namespace {
@@ -49,6 +55,93 @@ TEST(PngRoundTrip, Gamma2IsTheSquareRoot) {
   const std::vector<float> rgb = {0.25f, 0.64f, 0.09f, 1.0f, 0.0f, 4.0f};
   const std::vector<unsigned char> expected = {128, 204, 77, 255, 0, 255};  // round(255 sqrt(v)), halves up
   EXPECT_EQ(round_trip(rgb, 1, 2, Encoding::Gamma2), expected);
+}
+
+// The write run in a child process whose files may not grow past `limit` bytes (a
+// full disk: test::limit_file_size). Returns the OutputWriteError's message, or what
+// happened instead.
+std::string write_error_with_file_size_limit(unsigned long long limit, const std::function<void()>& write) {
+  return test::in_child_process([&]() -> std::string {
+    if (!test::limit_file_size(limit)) return "setrlimit failed";
+    try {
+      write();
+    } catch (const OutputWriteError& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("not an OutputWriteError: ") + e.what();
+    }
+    return "no error";
+  });
+}
+
+class FullDisk : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("wavetrace_full_disk_" + std::to_string(::getpid()) + "_" +
+                                        testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  std::vector<std::string> files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename().string());
+    return names;
+  }
+  static std::string efbig(const std::string& path) { return path + ": cannot write (" + std::strerror(EFBIG) + ")"; }
+
+  fs::path dir_;
+};
+
+// 64 x 64 pixels of noise: a 12 KiB PNG (noise does not compress), a 48 KiB PFM.
+std::vector<float> noise() {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::vector<float> rgb(64 * 64 * 3);
+  for (float& v : rgb) v = u(rng);
+  return rgb;
+}
+
+TEST_F(FullDisk, PngWriteFailsNamingTheFileAndLeavesNothing) {
+  const std::string out = path("out.png");
+  EXPECT_EQ(write_error_with_file_size_limit(4096, [&] { write_image(out, 64, 64, noise(), Encoding::Srgb); }),
+            efbig(out));
+  EXPECT_EQ(files(), std::vector<std::string>{});  // neither the image nor its temporary file
+}
+
+TEST_F(FullDisk, PfmWriteFailsNamingTheFileAndLeavesNothing) {
+  const std::string out = path("out.pfm");
+  EXPECT_EQ(write_error_with_file_size_limit(20000, [&] { write_image(out, 64, 64, noise(), Encoding::Srgb); }),
+            efbig(out));
+  EXPECT_EQ(files(), std::vector<std::string>{});
+}
+
+TEST_F(FullDisk, TextWriteFailsNamingTheFileAndLeavesNothing) {
+  const std::string out = path("stats.json");
+  EXPECT_EQ(write_error_with_file_size_limit(100, [&] { write_file(out, std::string(1000, 'x')); }), efbig(out));
+  EXPECT_EQ(files(), std::vector<std::string>{});
+}
+
+TEST_F(FullDisk, AFailedWriteLeavesAnEarlierFileAsItWas) {
+  const std::string out = path("out.pfm");
+  write_image(out, 2, 1, {1, 2, 3, 4, 5, 6}, Encoding::Srgb);
+  std::ifstream before_file(out, std::ios::binary);
+  const std::string before((std::istreambuf_iterator<char>(before_file)), {});
+  EXPECT_EQ(write_error_with_file_size_limit(20000, [&] { write_image(out, 64, 64, noise(), Encoding::Srgb); }),
+            efbig(out));
+  EXPECT_EQ(files(), std::vector<std::string>{"out.pfm"});
+  std::ifstream after_file(out, std::ios::binary);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(after_file)), {}), before);
+}
+
+TEST_F(FullDisk, WritesThatFitSucceedUnderTheSameLimit) {
+  // The limit itself is not what fails the writes above: the same limit, a file that fits.
+  const std::string out = path("out.pfm");
+  EXPECT_EQ(write_error_with_file_size_limit(20000, [&] { write_image(out, 4, 4, noise(), Encoding::Srgb); }),
+            "no error");
+  EXPECT_EQ(files(), std::vector<std::string>{"out.pfm"});
 }
 
 }  // namespace

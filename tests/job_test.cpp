@@ -3,9 +3,11 @@
 // failing job and says so in its exit code.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -176,6 +178,55 @@ TEST_F(JobTest, BatchOfGoodJobsSucceeds) {
   EXPECT_EQ(run_batch(read_jobs_file(jobs, base)), 0);
   EXPECT_TRUE(fs::exists(path("a.png")));
   EXPECT_TRUE(fs::exists(path("b.pfm")));
+}
+
+// A disk that fills up while the stats file is written, after the image: in a child
+// process whose files may not grow past a limit between the two files' sizes
+// (test::limit_file_size: the write fails with EFBIG, as with ENOSPC).
+TEST_F(JobTest, DiskFullWhileWritingStatsFailsTheJobAndWritesNeitherFile) {
+  Job j = small_job(write("s.json", kTinyScene), path("out.png"));
+  j.stats = path("stats.json");
+  ASSERT_EQ(run_job(j).exit_code, 0);
+  const uintmax_t image_bytes = fs::file_size(j.output), stats_bytes = fs::file_size(j.stats);
+  ASSERT_LT(image_bytes + 64, stats_bytes);  // room for a limit between them
+  fs::remove(j.output);
+  fs::remove(j.stats);
+  Job fits = small_job(j.scene, path("fits.png"));
+  const std::string result = test::in_child_process([&] {
+    if (!test::limit_file_size((image_bytes + stats_bytes) / 2)) return std::string("setrlimit failed");
+    const JobOutcome o = run_job(j);
+    // A batch goes on to the next job, whose image fits.
+    const int batch = run_batch({{j, ""}, {fits, ""}});
+    return std::to_string(o.exit_code) + " " + o.message + " | batch " + std::to_string(batch);
+  });
+  EXPECT_EQ(result, std::to_string(kExitFailure) + " " + j.stats + ": cannot write (" + std::strerror(EFBIG) +
+                        ") | batch " + std::to_string(kExitFailure));
+  EXPECT_TRUE(only_expected_files({"s.json", "fits.png"}));  // no image, no stats, no temporary file
+}
+
+// Host memory that runs out during a job (std::bad_alloc) fails that job alone: in a
+// child process whose address space is capped 1 GiB above what it uses, a 16384 x
+// 16384 film (3 GiB) cannot be allocated; the next job runs.
+TEST_F(JobTest, OutOfHostMemoryFailsOnlyThatJob) {
+  Job huge = small_job(write("s.json", kTinyScene), path("huge.pfm"));
+  huge.width = 16384;
+  huge.height = 16384;
+  huge.spp = 1;
+  huge.threads = 2;  // few threads: their stacks count against the cap
+  Job next = small_job(huge.scene, path("next.png"));
+  next.threads = 2;
+  const std::string result = test::in_child_process([&] {
+    long pages = 0;
+    std::ifstream("/proc/self/statm") >> pages;  // the address space in use
+    const rlim_t cap = static_cast<rlim_t>(pages) * ::sysconf(_SC_PAGESIZE) + (rlim_t(1) << 30);
+    const rlimit r{cap, cap};
+    if (::setrlimit(RLIMIT_AS, &r) != 0) return std::string("setrlimit failed");
+    const JobOutcome o = run_job(huge);
+    return std::to_string(o.exit_code) + " " + o.message + " | batch " + std::to_string(run_batch({{huge, ""}, {next, ""}}));
+  });
+  EXPECT_EQ(result, std::to_string(kExitFailure) + " out of host memory (std::bad_alloc) | batch " +
+                        std::to_string(kExitFailure));
+  EXPECT_TRUE(only_expected_files({"s.json", "next.png"}));
 }
 
 TEST_F(JobTest, MalformedJobsFileIsRejected) {

@@ -1,5 +1,11 @@
 #include "test_support.hpp"
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -40,6 +46,49 @@ std::vector<float> read_pfm(const std::string& path, int width, int height) {
   }
   if (!f) ADD_FAILURE() << path << ": short file";
   return rgb;
+}
+
+std::string in_child_process(const std::function<std::string()>& fn) {
+  int fds[2];
+  if (::pipe(fds) != 0) return "child process failed: pipe";
+  const pid_t pid = ::fork();
+  if (pid < 0) return "child process failed: fork";
+  if (pid == 0) {
+    ::close(fds[0]);
+    std::string text;
+    try {
+      text = fn();
+    } catch (const std::exception& e) {
+      text = std::string("child process failed: threw ") + e.what();
+    }
+    for (size_t done = 0; done < text.size();) {
+      const ssize_t k = ::write(fds[1], text.data() + done, text.size() - done);
+      if (k <= 0) ::_exit(3);
+      done += static_cast<size_t>(k);
+    }
+    ::_exit(0);  // no atexit handlers or gtest teardown in the child
+  }
+  ::close(fds[1]);
+  std::string text;
+  char buf[4096];
+  for (ssize_t k; (k = ::read(fds[0], buf, sizeof buf)) != 0;) {
+    if (k > 0) text.append(buf, static_cast<size_t>(k));
+    else if (errno != EINTR) break;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return "child process failed: status " + std::to_string(status) + " after \"" + text + "\"";
+  }
+  return text;
+}
+
+bool limit_file_size(unsigned long long bytes) {
+  std::signal(SIGXFSZ, SIG_IGN);
+  const rlimit r{static_cast<rlim_t>(bytes), static_cast<rlim_t>(bytes)};
+  return ::setrlimit(RLIMIT_FSIZE, &r) == 0;
 }
 
 }  // namespace wt::test

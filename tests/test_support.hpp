@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,16 @@ bool cuda_available();
 // A PFM as the command writes it (linear RGB, row 0 = top, as renders return it);
 // a failure is added to the test where the file is not a width x height PFM.
 std::vector<float> read_pfm(const std::string& path, int width, int height);
+
+// Runs fn in a child process (fork) and returns what it returned, so that a test can
+// put limits on the child (RLIMIT_FSIZE, RLIMIT_AS) that the test process keeps
+// clear of. A child that dies or exits otherwise gives "child process failed: ...".
+std::string in_child_process(const std::function<std::string()>& fn);
+
+// In such a child: a disk that fills up, for real and unprivileged. Files may not grow
+// past `bytes` (RLIMIT_FSIZE) and SIGXFSZ is ignored, so a write past the limit fails
+// with EFBIG, as a write to a full disk fails with ENOSPC. False if it cannot be set.
+bool limit_file_size(unsigned long long bytes);
 
 }  // namespace wt::test
 

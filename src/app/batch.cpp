@@ -101,7 +101,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
     double seconds = 0, mrays = 0;
   };
   std::vector<Row> rows;
-  int failed = 0, interrupted = 0;
+  int failed = 0, interrupted = 0, resets = 0;
   for (size_t i = 0; i < jobs.size(); ++i) {
     const PlannedJob& pj = jobs[i];
     std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, jobs.size(), pj.job.scene.c_str());
@@ -124,6 +124,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
     }
     if (o.exit_code != 0) {
       ++failed;
+      resets += o.device_reset;
       row.status = "FAILED: " + o.message;
       std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
     } else {
@@ -149,6 +150,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
                 r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
   }
   std::printf("%zu jobs: %zu ok, %d failed", rows.size(), rows.size() - failed, failed);
+  std::printf(resets ? " (the device was reset after %d of them)" : "", resets);
   if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - rows.size());
   std::printf("\n");
   if (interrupted) return interrupted;

@@ -227,8 +227,8 @@ int run_bench(const BenchOptions& options) {
         << r.value("rays_per_path", 0.0) << ","
         << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << "\n";
   }
-  write_text_file((fs::path(options.out_dir) / "results.json").string(), results.dump(1) + "\n");
-  write_text_file((fs::path(options.out_dir) / "results.csv").string(), csv.str());
+  write_file((fs::path(options.out_dir) / "results.json").string(), results.dump(1) + "\n");
+  write_file((fs::path(options.out_dir) / "results.csv").string(), csv.str());
   std::fprintf(stderr, "bench: %zu points, %d failed; results in %s\n", total, failures, options.out_dir.c_str());
   return failures ? kExitFailure : 0;
 }

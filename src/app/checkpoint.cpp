@@ -75,7 +75,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   put<uint64_t>(out, c.film.size());
   out.append(reinterpret_cast<const char*>(c.film.data()), c.film.size() * sizeof(float));
   put<uint32_t>(out, crc_of(out.data(), out.size()));
-  write_text_file(path, out);  // written through a temporary file renamed into place
+  write_file(path, out);
 }
 
 Checkpoint read_checkpoint(const std::string& path) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <new>
 #include <nlohmann/json.hpp>
 
 #include "app/checkpoint.hpp"
@@ -94,6 +95,16 @@ void print_profile(const RenderResult& r) {
   std::fprintf(stderr, r.live_per_bounce.size() > 40 ? " ...\n" : "\n");
 }
 
+// After a device failure: the next job must start on a clean device context.
+void recover_device(JobOutcome& out) {
+  try {
+    out.device_reset = cuda::recover_after_error() == cuda::Recovery::Reset;
+    if (out.device_reset) out.message += "; the device was reset";
+  } catch (const DeviceError& e) {
+    out.message += std::string("; the device could not be reset: ") + e.what();
+  }
+}
+
 }  // namespace
 
 JobOutcome run_job(const Job& job) {
@@ -163,8 +174,13 @@ JobOutcome run_job(const Job& job) {
                     "; checkpoint written to " + checkpoint_path + " (resume with --resume " + checkpoint_path + ")";
       return out;
     }
-    write_image(job.output, options.params.width, options.params.height, out.result.rgb, job.encoding);
-    if (!job.stats.empty()) write_text_file(job.stats, stats_json(job, out).dump(2) + "\n");
+    // Both files are written in full before either takes its name: a disk that fills
+    // up during the second leaves neither.
+    StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
+                                   job.encoding);
+    StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
+    image.commit();
+    stats.commit();
     // The image is written: the checkpoint has served its purpose.
     if (!checkpoint_path.empty()) std::filesystem::remove(checkpoint_path);
     if (job.profile) {
@@ -174,18 +190,25 @@ JobOutcome run_job(const Job& job) {
   } catch (const SceneError& e) {
     out.exit_code = kExitBadInput;
     out.message = e.what();
+  } catch (const OutputWriteError& e) {
+    out.exit_code = kExitFailure;  // the path was fine; the disk was not
+    out.message = e.what();
   } catch (const OutputError& e) {
     out.exit_code = kExitBadInput;
     out.message = e.what();
-  } catch (const cuda::CudaError& e) {
-    out.exit_code = kExitFailure;
-    out.message = std::string("CUDA error: ") + e.what();
   } catch (const DeviceError& e) {
     out.exit_code = kExitFailure;
-    out.message = e.what();
+    out.message = (dynamic_cast<const cuda::CudaError*>(&e) ? "CUDA error: " : "") + std::string(e.what());
+    recover_device(out);
+  } catch (const std::bad_alloc&) {
+    out.exit_code = kExitFailure;
+    out.message = "out of host memory (std::bad_alloc)";
   } catch (const std::exception& e) {
     out.exit_code = kExitFailure;
     out.message = e.what();
+  } catch (...) {
+    out.exit_code = kExitFailure;
+    out.message = "failed with an unknown error";
   }
   return out;
 }

@@ -41,6 +41,7 @@ constexpr int kExitFailure = 1;
 struct JobOutcome {
   int exit_code = 0;
   std::string message;  // the one line that says why, when exit_code != 0
+  bool device_reset = false;  // the job failed on the device, and the device was reset after it
   RenderParams params{};
   LoadTimes load_times;
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
@@ -48,7 +49,9 @@ struct JobOutcome {
   RenderResult result;
 };
 
-// Runs a job; never throws. Writes the image (and stats) only when the render succeeded.
+// Runs a job; never throws. Writes the image (and stats) only when the render and
+// both writes succeeded. After a device failure it leaves the device fit for the next
+// job (cuda::recover_after_error: a reset when the context was poisoned).
 JobOutcome run_job(const Job& job);
 
 // Sets a setting of the table (already checked against its range).

@@ -30,7 +30,8 @@ class DeviceBuffer {
   void allocate(size_t n, const char* stage) {
     release();
     if (n == 0) return;
-    WT_CUDA(cudaMalloc(reinterpret_cast<void**>(&ptr_), n * sizeof(T)), stage);
+    check_allocation(static_cast<int>(cudaMalloc(reinterpret_cast<void**>(&ptr_), n * sizeof(T))), n * sizeof(T),
+                     stage);
     size_ = n;
   }
 

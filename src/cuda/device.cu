@@ -13,11 +13,45 @@ int device_count() {
   return n;
 }
 
+namespace {
+
+std::string error_text(cudaError_t err) {
+  return std::string(cudaGetErrorName(err)) + " (" + cudaGetErrorString(err) + ")";
+}
+
+std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >> 20) + " MiB"; }
+
+}  // namespace
+
 void check(int code, const char* call, const char* stage) {
   if (code == cudaSuccess) return;
   auto err = static_cast<cudaError_t>(code);
-  throw CudaError(std::string(stage) + ": " + call + " failed: " + cudaGetErrorName(err) + " (" +
-                  cudaGetErrorString(err) + ")");
+  cudaGetLastError();  // reported here: a later launch check must not report it again
+  const char* what = err == cudaErrorMemoryAllocation ? ": out of device memory: " : ": ";
+  throw CudaError(std::string(stage) + what + call + " failed: " + error_text(err));
+}
+
+void check_allocation(int code, size_t bytes, const char* stage) {
+  if (code == cudaErrorMemoryAllocation) {
+    cudaGetLastError();
+    throw CudaError(std::string(stage) + ": out of device memory: allocating " + mib(bytes) + " failed: " +
+                    error_text(cudaErrorMemoryAllocation));
+  }
+  check(code, "cudaMalloc", stage);
+}
+
+Recovery recover_after_error() {
+  if (device_count() == 0) return Recovery::Clean;
+  cudaGetLastError();  // an error of the failed call that did not poison the context
+  // A poisoned context answers every call with its error, and the wait also brings
+  // out a fault of work still queued.
+  cudaError_t err = cudaDeviceSynchronize();
+  if (err == cudaSuccess) err = cudaGetLastError();
+  if (err == cudaSuccess) return Recovery::Clean;
+  WT_CUDA(cudaDeviceReset(), "device reset");
+  WT_CUDA(cudaFree(nullptr), "device reset");  // makes the new context now, or says why it cannot
+  WT_CUDA(cudaDeviceSynchronize(), "device reset");
+  return Recovery::Reset;
 }
 
 DeviceInfo device_info() {

@@ -30,8 +30,24 @@ struct DeviceInfo {
 
 DeviceInfo device_info();
 
-// Throws CudaError "<stage>: <call> failed: <error>" when code is not cudaSuccess.
+// Throws CudaError "<stage>: <call> failed: <error>" when code is not cudaSuccess;
+// for an allocation that failed, "<stage>: out of device memory: <call> failed: ...".
 void check(int code, const char* call, const char* stage);
+
+// A device allocation of `bytes`: the same, with the size when the device is out of memory.
+void check_allocation(int code, size_t bytes, const char* stage);
+
+enum class Recovery {
+  Clean,  // the context was usable: any error left by the failed call is cleared
+  Reset,  // the context was poisoned (a sticky error: an illegal address, a kernel that
+          // faulted) and the device was reset, freeing all this process held on it
+};
+
+// After a job failed with a DeviceError, makes the device fit for the next job. A
+// reset destroys every allocation, stream and event of the process on the device:
+// call it only when nothing of the failed job is still held. Throws CudaError when the
+// device is still unusable after the reset.
+Recovery recover_after_error();
 
 }  // namespace wt::cuda
 

@@ -1,5 +1,6 @@
 #include "image/image_io.hpp"
 
+#include <fcntl.h>
 #include <stb/stb_image_write.h>
 #include <unistd.h>
 
@@ -8,7 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <utility>
 
 #include "wavetrace/film.hpp"
 
@@ -42,42 +43,91 @@ std::string temporary_name(const std::string& path) {
   return path + ".tmp." + std::to_string(::getpid());
 }
 
-// Renames tmp over path, or removes tmp and throws.
-void commit(const std::string& tmp, const std::string& path) {
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    fs::remove(tmp);
-    throw OutputError(path + ": cannot write (" + ec.message() + ")");
-  }
+std::string write_failure(const std::string& path, int err) {
+  return path + ": cannot write (" + std::strerror(err) + ")";
 }
 
-void write_png(const std::string& tmp, const std::string& path, int w, int h, const std::vector<float>& rgb,
-               Encoding encoding) {
+}  // namespace
+
+// Writes a file's bytes to its temporary file. A failed write is remembered, not
+// thrown, so that the PNG encoder (C code) can call write(); finish() reports it.
+class FileWriter {
+ public:
+  explicit FileWriter(const std::string& path) {
+    staged_.path_ = path;
+    staged_.tmp_ = temporary_name(path);
+    fd_ = ::open(staged_.tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd_ < 0) {
+      const int err = errno;
+      staged_.tmp_.clear();  // not created: nothing to remove
+      throw OutputWriteError(write_failure(path, err));
+    }
+  }
+  ~FileWriter() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FileWriter(const FileWriter&) = delete;
+  FileWriter& operator=(const FileWriter&) = delete;
+
+  // Writes all n bytes, or records why not (a short write is retried and then fails
+  // with the reason: ENOSPC, EFBIG, EIO).
+  void write(const void* data, size_t n) noexcept {
+    const char* p = static_cast<const char*>(data);
+    while (n > 0 && error_ == 0) {
+      const ssize_t k = ::write(fd_, p, n);
+      if (k < 0) {
+        if (errno != EINTR) error_ = errno;
+      } else {
+        p += k;
+        n -= static_cast<size_t>(k);
+      }
+    }
+  }
+  void fail(int err) noexcept {
+    if (error_ == 0) error_ = err;
+  }
+
+  // Flushes to the disk and closes: errors that only show there (a full disk under
+  // delayed allocation, a failed device, a network file system) are found here.
+  StagedFile finish() {
+    if (error_ == 0 && ::fsync(fd_) != 0) error_ = errno;
+    if (::close(std::exchange(fd_, -1)) != 0 && error_ == 0) error_ = errno;
+    if (error_ != 0) throw OutputWriteError(write_failure(staged_.path_, error_));  // ~StagedFile removes tmp
+    return std::move(staged_);
+  }
+
+ private:
+  StagedFile staged_;
+  int fd_ = -1;
+  int error_ = 0;
+};
+
+namespace {
+
+void append_to_writer(void* context, void* data, int size) {
+  static_cast<FileWriter*>(context)->write(data, static_cast<size_t>(size));
+}
+
+StagedFile stage_png(const std::string& path, int w, int h, const std::vector<float>& rgb, Encoding encoding) {
   std::vector<unsigned char> bytes(rgb.size());
   for (size_t i = 0; i < rgb.size(); ++i) {
     float v = encoding == Encoding::Srgb ? encode_srgb(rgb[i]) : encode_gamma2(rgb[i]);
     bytes[i] = static_cast<unsigned char>(std::lround(v * 255.0f));
   }
-  if (!stbi_write_png(tmp.c_str(), w, h, 3, bytes.data(), w * 3)) {
-    fs::remove(tmp);
-    throw OutputError(path + ": cannot write PNG");
-  }
+  FileWriter f(path);
+  if (!stbi_write_png_to_func(append_to_writer, &f, w, h, 3, bytes.data(), w * 3)) f.fail(ENOMEM);  // encoder's malloc
+  return f.finish();
 }
 
 // PFM: a text header, then little-endian floats, bottom row first.
-void write_pfm(const std::string& tmp, const std::string& path, int w, int h, const std::vector<float>& rgb) {
-  std::ofstream f(tmp, std::ios::binary);
-  f << "PF\n" << w << " " << h << "\n-1.0\n";
+StagedFile stage_pfm(const std::string& path, int w, int h, const std::vector<float>& rgb) {
+  FileWriter f(path);
+  const std::string header = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+  f.write(header.data(), header.size());
   for (int y = h - 1; y >= 0; --y) {
-    f.write(reinterpret_cast<const char*>(rgb.data() + static_cast<size_t>(y) * w * 3),
-            static_cast<std::streamsize>(sizeof(float) * w * 3));
+    f.write(rgb.data() + static_cast<size_t>(y) * w * 3, sizeof(float) * w * 3);
   }
-  f.close();
-  if (!f) {
-    fs::remove(tmp);
-    throw OutputError(path + ": cannot write PFM");
-  }
+  return f.finish();
 }
 
 }  // namespace
@@ -100,29 +150,48 @@ void check_output_folder(const std::string& path) {
   if (fs::is_directory(path, ec)) throw OutputError(path + ": cannot write: it is a folder");
 }
 
-void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding) {
-  Format format = format_of(path);
-  std::string tmp = temporary_name(path);
-  if (format == Format::Png) {
-    write_png(tmp, path, width, height, rgb, encoding);
-  } else {
-    write_pfm(tmp, path, width, height, rgb);
-  }
-  commit(tmp, path);
+StagedFile::~StagedFile() { discard(); }
+
+StagedFile::StagedFile(StagedFile&& o) noexcept : path_(std::move(o.path_)), tmp_(std::exchange(o.tmp_, {})) {}
+
+StagedFile& StagedFile::operator=(StagedFile&& o) noexcept {
+  discard();
+  path_ = std::move(o.path_);
+  tmp_ = std::exchange(o.tmp_, {});
+  return *this;
 }
 
-void write_text_file(const std::string& path, const std::string& text) {
-  std::string tmp = temporary_name(path);
-  {
-    std::ofstream f(tmp);
-    f << text;
-    f.close();
-    if (!f) {
-      fs::remove(tmp);
-      throw OutputError(path + ": cannot write");
-    }
-  }
-  commit(tmp, path);
+void StagedFile::discard() noexcept {
+  if (!tmp_.empty()) ::unlink(tmp_.c_str());
+  tmp_.clear();
 }
+
+void StagedFile::commit() {
+  if (tmp_.empty()) return;
+  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    const int err = errno;
+    discard();
+    throw OutputWriteError(write_failure(path_, err));
+  }
+  tmp_.clear();
+}
+
+StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
+                       Encoding encoding) {
+  return format_of(path) == Format::Png ? stage_png(path, width, height, rgb, encoding)
+                                        : stage_pfm(path, width, height, rgb);
+}
+
+StagedFile stage_file(const std::string& path, const std::string& text) {
+  FileWriter f(path);
+  f.write(text.data(), text.size());
+  return f.finish();
+}
+
+void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding) {
+  stage_image(path, width, height, rgb, encoding).commit();
+}
+
+void write_file(const std::string& path, const std::string& text) { stage_file(path, text).commit(); }
 
 }  // namespace wt

@@ -13,6 +13,13 @@ struct OutputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// The output path passed its checks but the write failed: the disk filled up (ENOSPC),
+// the file grew past a limit (EFBIG), the disk failed (EIO). A failure of the machine,
+// not of the input; the message names the file and the system's reason.
+struct OutputWriteError : OutputError {
+  using OutputError::OutputError;
+};
+
 enum class Encoding { Srgb, Gamma2 };
 
 // Throws OutputError naming the path when it cannot be written (unknown extension,
@@ -22,11 +29,37 @@ void check_output_path(const std::string& path);
 // The folder part of that check alone, for files of any kind.
 void check_output_folder(const std::string& path);
 
-// rgb: linear radiance, width * height * 3, row 0 = top. The encoding applies to PNG;
-// PFM keeps linear values.
-void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding);
+// A file written in full to a temporary file beside its path (every write checked,
+// then flushed to the disk and closed, so a full disk is found here and not later)
+// and not yet under its name. commit() renames it into place; destroyed uncommitted,
+// it removes the temporary file. A default one holds nothing and commits nothing.
+class StagedFile {
+ public:
+  StagedFile() = default;
+  ~StagedFile();
+  StagedFile(StagedFile&& o) noexcept;
+  StagedFile& operator=(StagedFile&& o) noexcept;
+  StagedFile(const StagedFile&) = delete;
+  StagedFile& operator=(const StagedFile&) = delete;
 
-// Writes text to path atomically (temporary file, then rename).
-void write_text_file(const std::string& path, const std::string& text);
+  // Throws OutputWriteError naming the path (the temporary file removed).
+  void commit();
+
+ private:
+  friend class FileWriter;
+  void discard() noexcept;
+  std::string path_, tmp_;  // tmp_ empty: nothing staged
+};
+
+// rgb: linear radiance, width * height * 3, row 0 = top. The encoding applies to PNG;
+// PFM keeps linear values. Throws OutputWriteError when the write fails.
+StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
+                       Encoding encoding);
+// Any bytes (a stats file's text, a checkpoint).
+StagedFile stage_file(const std::string& path, const std::string& bytes);
+
+// Stage and commit at once.
+void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding);
+void write_file(const std::string& path, const std::string& bytes);
 
 }  // namespace wt
