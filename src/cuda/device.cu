@@ -27,7 +27,8 @@ void check(int code, const char* call, const char* stage) {
   if (code == cudaSuccess) return;
   auto err = static_cast<cudaError_t>(code);
   cudaGetLastError();  // reported here: a later launch check must not report it again
-  const char* what = err == cudaErrorMemoryAllocation ? ": out of device memory: " : ": ";
+  // Device allocations say which (check_allocation); this is any call that ran out, host pinned memory too.
+  const char* what = err == cudaErrorMemoryAllocation ? ": out of memory: " : ": ";
   throw CudaError(std::string(stage) + what + call + " failed: " + error_text(err));
 }
 

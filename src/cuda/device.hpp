@@ -31,7 +31,7 @@ struct DeviceInfo {
 DeviceInfo device_info();
 
 // Throws CudaError "<stage>: <call> failed: <error>" when code is not cudaSuccess;
-// for an allocation that failed, "<stage>: out of device memory: <call> failed: ...".
+// for a call that ran out of memory, "<stage>: out of memory: <call> failed: ...".
 void check(int code, const char* call, const char* stage);
 
 // A device allocation of `bytes`: the same, with the size when the device is out of memory.

@@ -59,7 +59,7 @@ int block_size_for(const Stage& s) {
 class Executor {
  public:
   explicit Executor(cudaStream_t stream = nullptr) : stream_(stream), timer_("wavefront") {
-    WT_CUDA(cudaMallocHost(&pinned_, kPinnedBytes), "wave allocation");
+    WT_CUDA(cudaMallocHost(&pinned_, kPinnedBytes), "pinned host memory for the wave's counters");
   }
   ~Executor() { cudaFreeHost(pinned_); }
   Executor(const Executor&) = delete;
