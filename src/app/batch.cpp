@@ -72,7 +72,7 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
   json doc;
   try {
     doc = json::parse(f);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     throw SceneError(path + ": malformed JSON: " + e.what());
   }
   if (!doc.is_object() || !doc.contains("jobs") || !doc["jobs"].is_array()) {
