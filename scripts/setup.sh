@@ -6,6 +6,11 @@ packages=(cmake ninja-build g++ libglm-dev nlohmann-json3-dev libstb-dev libcli1
 if [[ "${WAVETRACE_WITH_PLOTS:-0}" == 1 ]]; then
   packages+=(python3-matplotlib)
 fi
+# scripts/fuzz.sh: clang, its libFuzzer and sanitizer runtimes, llvm-symbolizer. Version
+# 19: bookworm's default clang (14) rejects lambdas that capture structured bindings.
+if [[ "${WAVETRACE_WITH_FUZZ:-0}" == 1 ]]; then
+  packages+=(clang-19 libclang-rt-19-dev llvm-19)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -188,8 +188,10 @@ class SceneReader : JsonReader {
     if (known != images_.end()) return known->second;
 
     const auto start = Clock::now();
+    // Read in the file's own channels and widened to RGBA here: stb 2.27 (Debian
+    // bookworm) reads past its buffer when it converts a 16-bit PNM to 4 channels.
     int w = 0, h = 0, channels = 0;
-    stbi_uc* data = stbi_load(resolved.c_str(), &w, &h, &channels, 4);
+    stbi_uc* data = stbi_load(resolved.c_str(), &w, &h, &channels, 0);
     if (!data) fail_at(path, "cannot read image '" + resolved + "' (" + stbi_failure_reason() + ")");
     Image im;
     im.path = resolved;
@@ -197,8 +199,11 @@ class SceneReader : JsonReader {
     im.height = h;
     im.texels.resize(static_cast<size_t>(w) * h * 4);
     for (size_t i = 0; i < im.texels.size(); ++i) {
-      float v = data[i] / 255.0f;
+      const stbi_uc* texel = data + i / 4 * channels;
       bool alpha = i % 4 == 3;
+      // grey: g g g 1; grey + alpha: g g g a; RGB: r g b 1; RGBA.
+      float v = alpha ? (channels % 2 == 0 ? texel[channels - 1] / 255.0f : 1.0f)
+                      : texel[channels >= 3 ? i % 4 : 0] / 255.0f;
       im.texels[i] = srgb && !alpha ? decode_srgb(v) : v;
     }
     stbi_image_free(data);

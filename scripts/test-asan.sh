@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Builds wavetrace with AddressSanitizer (leaks included) and UndefinedBehaviorSanitizer
+# into build-asan/ (or $WAVETRACE_ASAN_BUILD) and runs the whole test suite there:
+# the C++ code, the host side of the .cu files (through nvcc -Xcompiler) and the fuzz
+# corpus regression tests. Any report fails the test that made it. CI runs this after
+# scripts/test.sh; GPU tests skip where there is no CUDA device, as they do there.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build=${WAVETRACE_ASAN_BUILD:-$root/build-asan}
+bash "$root/scripts/setup.sh"
+sanitize=(-fsanitize=address -fsanitize=undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+if [[ ! -f "$build/build.ninja" ]]; then
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_CXX_FLAGS="${sanitize[*]}" \
+    -DCMAKE_CUDA_FLAGS="${sanitize[*]/#/-Xcompiler=}" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address -fsanitize=undefined" >/dev/null
+fi
+cmake --build "$build" --parallel "$(nproc)"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
+cd "$build"
+ctest --output-on-failure --parallel "$(nproc)"
