@@ -1,13 +1,19 @@
 // Faults during a job on the device: a kernel that faults (the tests' own, storing
-// through a null pointer) poisons the context; the job that meets it fails with one
-// line, writes nothing, and the device is reset so that the next job runs. An
-// allocation larger than the device fails naming the allocation, frees what was
-// allocated before it, and needs no reset. These tests skip without a device.
+// through a null pointer) poisons the context of its process for good; the job that
+// meets it fails with one line, writes nothing, and says the context cannot be
+// recovered; an in-process batch then fails its CUDA jobs at once and still runs its
+// CPU jobs. Those tests fault in a fresh process of their own (a death test in the
+// "threadsafe" style re-executes this binary for the statement), so that the test
+// process keeps a clean context. An allocation larger than the device fails naming
+// the allocation, frees what was allocated before it, and leaves the context usable.
+// These tests skip without a device.
 #include <gtest/gtest.h>
 
 #include <cuda_runtime.h>
 #include <unistd.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -82,40 +88,75 @@ std::string poison_message() {
   return "no error";
 }
 
-TEST_F(DeviceFaults, KernelFaultFailsTheNextJobAloneAndTheDeviceIsReset) {
-  const std::string fault = poison_message();
-  EXPECT_EQ(fault.rfind("fault test: cudaDeviceSynchronize() failed: cudaErrorIllegalAddress (", 0), 0u) << fault;
-
-  // The poisoned context fails the job that meets it: one line, exit 1, no image.
-  const JobOutcome failed = app::run_job(cuda_job("a.png"));
-  EXPECT_EQ(failed.exit_code, app::kExitFailure);
-  EXPECT_EQ(failed.message.rfind("CUDA error: ", 0), 0u) << failed.message;
-  EXPECT_NE(failed.message.find("cudaErrorIllegalAddress"), std::string::npos) << failed.message;
-  EXPECT_NE(failed.message.find("; the device was reset"), std::string::npos) << failed.message;
-  EXPECT_EQ(failed.message.find('\n'), std::string::npos) << failed.message;
-  EXPECT_TRUE(failed.device_reset);
-  EXPECT_FALSE(fs::exists(path("a.png")));
-
-  // And the next job runs on the reset device.
-  const JobOutcome next = app::run_job(cuda_job("b.png"));
-  EXPECT_EQ(next.exit_code, 0) << next.message;
-  EXPECT_TRUE(fs::exists(path("b.png")));
+// In a death test's child: ends it, with 0 only if no check of the test failed (the
+// child's failures are printed there and do not reach the parent's test result).
+[[noreturn]] void exit_with_checks(const fs::path& dir) {
+  fs::remove_all(dir);  // the child's own folder: its SetUp made it, its TearDown does not run
+  std::fflush(stdout);
+  std::fflush(stderr);
+  std::_Exit(testing::Test::HasFailure() ? 1 : 0);
 }
 
-TEST_F(DeviceFaults, BatchGoesOnPastAKernelFault) {
-  poison_message();
-  const std::vector<app::PlannedJob> jobs = {{cuda_job("a.png"), ""}, {cuda_job("b.png", "wavefront"), ""}};
-  EXPECT_EQ(app::run_batch(jobs), app::kExitFailure);
-  EXPECT_FALSE(fs::exists(path("a.png")));
-  EXPECT_TRUE(fs::exists(path("b.png")));
+TEST_F(DeviceFaults, KernelFaultLosesTheContextOfItsProcessAndTheJobSaysSo) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto in_child = [&] {
+    const std::string fault = poison_message();
+    EXPECT_EQ(fault.rfind("fault test: cudaDeviceSynchronize() failed: cudaErrorIllegalAddress (", 0), 0u) << fault;
+    // The poisoned context fails the job that meets it: one line naming the call
+    // and the stage, exit 1, no image, and the context is lost.
+    const JobOutcome failed = app::run_job(cuda_job("a.png"));
+    EXPECT_EQ(failed.exit_code, app::kExitFailure);
+    EXPECT_EQ(failed.message.rfind("CUDA error: ", 0), 0u) << failed.message;
+    EXPECT_NE(failed.message.find(" failed: cudaErrorIllegalAddress ("), std::string::npos) << failed.message;
+    EXPECT_NE(failed.message.find("; " + std::string(cuda::kContextLost)), std::string::npos) << failed.message;
+    EXPECT_EQ(failed.message.find('\n'), std::string::npos) << failed.message;
+    EXPECT_TRUE(failed.device_lost);
+    EXPECT_FALSE(fs::exists(path("a.png")));
+    // It stays lost: no later CUDA work of this process runs.
+    EXPECT_EQ(cuda::recover_after_error(), cuda::Recovery::Lost);
+    EXPECT_NE(app::run_job(cuda_job("b.png")).exit_code, 0);
+    EXPECT_FALSE(fs::exists(path("b.png")));
+    exit_with_checks(dir_);
+  };
+  EXPECT_EXIT(in_child(), testing::ExitedWithCode(0), "");
 }
 
-TEST_F(DeviceFaults, RecoveryResetsOnlyAPoisonedContextAndEveryKernelRunsAfterIt) {
+TEST_F(DeviceFaults, InProcessBatchFailsCudaJobsAtOnceAfterAStickyFaultAndRunsCpuJobs) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto in_child = [&] {
+    Job cpu = cuda_job("cpu.png");
+    cpu.backend = "cpu";
+    Job before = cuda_job("before.png");
+    const std::vector<app::PlannedJob> first = {{before, ""}};
+    EXPECT_EQ(app::run_batch(first), 0);
+    poison_message();
+    const std::vector<app::PlannedJob> jobs = {
+        {cuda_job("a.png"), ""}, {cuda_job("b.png", "wavefront"), ""}, {cpu, ""}, {cuda_job("c.png"), ""}};
+    testing::internal::CaptureStderr();
+    const int code = app::run_batch(jobs);
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(code, app::kExitFailure);
+    EXPECT_TRUE(fs::exists(path("before.png")));
+    EXPECT_FALSE(fs::exists(path("a.png")));
+    EXPECT_FALSE(fs::exists(path("b.png")));
+    EXPECT_TRUE(fs::exists(path("cpu.png")));
+    EXPECT_FALSE(fs::exists(path("c.png")));
+    // Job 1 meets the fault and says the context is lost; jobs 2 and 4 fail at once,
+    // one line each, naming job 1.
+    EXPECT_NE(err.find(cuda::kContextLost), std::string::npos) << err;
+    const std::string lost = "wavetrace: CUDA device lost in this process: job 1 met a sticky error;";
+    size_t count = 0;
+    for (size_t at = err.find(lost); at != std::string::npos; at = err.find(lost, at + 1)) ++count;
+    EXPECT_EQ(count, 2u) << err;
+    exit_with_checks(dir_);
+  };
+  EXPECT_EXIT(in_child(), testing::ExitedWithCode(0), "");
+}
+
+TEST_F(DeviceFaults, RecoveryFindsAUsableContextClean) {
+  // Nothing failed, or a failure that did not poison the context: the next job runs
+  // with every kernel in this process.
   EXPECT_EQ(cuda::recover_after_error(), cuda::Recovery::Clean);
-  poison_message();
-  EXPECT_EQ(cuda::recover_after_error(), cuda::Recovery::Reset);
-  EXPECT_EQ(cuda::recover_after_error(), cuda::Recovery::Clean);
-  // A fresh context: constant memory, kernel modules and cached block sizes all work.
   for (const std::string& kernel : kernel_names(Backend::Cuda)) {
     const JobOutcome o = app::run_job(cuda_job(kernel + ".png", kernel));
     EXPECT_EQ(o.exit_code, 0) << kernel << ": " << o.message;

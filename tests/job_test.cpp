@@ -208,6 +208,7 @@ TEST_F(JobTest, DiskFullWhileWritingStatsFailsTheJobAndWritesNeitherFile) {
 // child process whose address space is capped 1 GiB above what it uses, a 16384 x
 // 16384 film (3 GiB) cannot be allocated; the next job runs.
 TEST_F(JobTest, OutOfHostMemoryFailsOnlyThatJob) {
+  if (test::kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer's shadow memory cannot run under RLIMIT_AS";
   Job huge = small_job(write("s.json", kTinyScene), path("huge.pfm"));
   huge.width = 16384;
   huge.height = 16384;

@@ -19,6 +19,16 @@ std::string repo_path(const std::string& relative);
 
 bool cuda_available();
 
+// Whether this binary was built with AddressSanitizer (scripts/test-asan.sh): its
+// shadow memory and its quarantine of freed blocks change what a process's memory
+// figures mean, and it cannot run under an address-space limit.
+constexpr bool kAddressSanitizer =
+#if defined(__SANITIZE_ADDRESS__)
+    true;
+#else
+    false;
+#endif
+
 // A PFM as the command writes it (linear RGB, row 0 = top, as renders return it);
 // a failure is added to the test where the file is not a width x height PFM.
 std::vector<float> read_pfm(const std::string& path, int width, int height);

@@ -1,9 +1,17 @@
 #include "app/batch.hpp"
 
+#include <unistd.h>
+
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
+
+#include "app/cli.hpp"
+#include "app/process.hpp"
 
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -95,14 +103,22 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
   return jobs;
 }
 
-int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
+namespace {
+
+// Runs one job of a batch: its outcome, whose message the batch prints.
+using JobRunner = std::function<JobOutcome(size_t index, const Job& job)>;
+
+// The batch loop and its summary, whichever way the jobs run. `signal_caught`: a
+// signal the batch itself caught (0: none), which stops it after the job it ran.
+int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunner& run,
+             const std::function<int()>& signal_caught) {
   struct Row {
     std::string scene, settings, kernel, status;
     double seconds = 0, mrays = 0;
   };
   std::vector<Row> rows;
-  int failed = 0, interrupted = 0, resets = 0;
-  for (size_t i = 0; i < jobs.size(); ++i) {
+  int failed = 0, interrupted = 0;
+  for (size_t i = 0; i < jobs.size() && !interrupted; ++i) {
     const PlannedJob& pj = jobs[i];
     std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, jobs.size(), pj.job.scene.c_str());
     Row row;
@@ -120,11 +136,10 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
       o.exit_code = kExitBadInput;
       o.message = pj.error;
     } else {
-      o = run_job(pj.job);
+      o = run(i, pj.job);
     }
     if (o.exit_code != 0) {
       ++failed;
-      resets += o.device_reset;
       row.status = "FAILED: " + o.message;
       std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
     } else {
@@ -136,11 +151,10 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
       row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
     }
     rows.push_back(row);
-    // A signal stopped the job (after its last checkpoint): the batch stops too.
-    if (o.exit_code >= 128) {
-      interrupted = o.exit_code;
-      break;
-    }
+    // A signal stopped the job (after its last checkpoint), or reached the batch
+    // while the job ran: the batch stops too.
+    if (o.exit_code >= 128) interrupted = o.exit_code;
+    if (const int sig = signal_caught ? signal_caught() : 0; sig != 0 && !interrupted) interrupted = 128 + sig;
   }
   std::printf("%-4s %-32s %-22s %-26s %9s %10s  %s\n", "job", "scene", "settings", "backend/kernel", "seconds",
               "M rays/s", "result");
@@ -150,11 +164,101 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
                 r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
   }
   std::printf("%zu jobs: %zu ok, %d failed", rows.size(), rows.size() - failed, failed);
-  std::printf(resets ? " (the device was reset after %d of them)" : "", resets);
   if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - rows.size());
   std::printf("\n");
+  std::fflush(stdout);
   if (interrupted) return interrupted;
   return failed ? kExitFailure : 0;
+}
+
+// What a job's stats file says about its render, for the summary.
+void read_measurements(const std::string& path, JobOutcome& o) {
+  std::ifstream f(path);
+  const json j = json::parse(f, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return;
+  for (SettingId id : render_settings()) set_param(o.params, id, j["settings"].value(setting(id).key, int64_t(0)));
+  o.backend = j.value("backend", "");
+  o.kernel = j.value("kernel", "");
+  o.result.seconds = j.value("seconds", 0.0);
+  o.result.rays = j.value("rays", uint64_t(0));
+}
+
+std::string signal_name(int sig) {
+  if (sig == SIGINT) return "SIGINT";
+  if (sig == SIGTERM) return "SIGTERM";
+  return "signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
+}
+
+// Runs one job as `wavetrace render` in a process of its own.
+JobOutcome run_job_in_process(const std::string& executable, size_t index, const Job& job,
+                              const SignalForwarder& signals) {
+  JobOutcome o;
+  Job child_job = job;
+  // The summary's figures come from a stats file: the job's own, or one of ours.
+  if (child_job.stats.empty()) {
+    child_job.stats = (fs::temp_directory_path() / ("wavetrace-batch-" + std::to_string(::getpid()) + "-" +
+                                                    std::to_string(index + 1) + ".json"))
+                          .string();
+  }
+  ChildEnd end;
+  try {
+    end = run_child(executable, render_arguments(child_job));
+  } catch (const std::exception& e) {
+    o.exit_code = kExitFailure;
+    o.message = e.what();
+    return o;
+  }
+  if (end.exited) {
+    o.exit_code = end.exit_code;
+    o.message = end.last_line;
+    if (o.exit_code == 0) {
+      read_measurements(child_job.stats, o);
+      if (!end.last_line.empty()) std::fprintf(stderr, "wavetrace: %s\n", end.last_line.c_str());
+    } else if (o.message.empty()) {
+      o.message = "the job's process exited with " + std::to_string(o.exit_code) + " without saying why";
+    }
+  } else {
+    // A signal the batch passed on stops the batch, as a job interrupted after its
+    // checkpoint does; any other signal fails this job alone.
+    const bool passed_on = end.signal == signals.caught();
+    o.exit_code = passed_on ? 128 + end.signal : kExitFailure;
+    o.message = "the job's process was killed by " + signal_name(end.signal);
+  }
+  if (child_job.stats != job.stats) {
+    std::error_code ignored;
+    fs::remove(child_job.stats, ignored);
+  }
+  return o;
+}
+
+}  // namespace
+
+int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
+  // A sticky error poisons this process's CUDA context for good: the CUDA jobs after
+  // it fail at once, the CPU jobs still run.
+  std::string lost_in;
+  const JobRunner run = [&](size_t index, const Job& job) {
+    if (!lost_in.empty() && job.backend != "cpu") {
+      JobOutcome o;
+      o.exit_code = kExitFailure;
+      o.device_lost = true;
+      o.message = "CUDA device lost in this process: job " + lost_in +
+                  " met a sticky error; a new process gets a clean context (wavetrace batch runs each job in its own)";
+      return o;
+    }
+    JobOutcome o = run_job(job);
+    if (o.device_lost) lost_in = std::to_string(index + 1);
+    return o;
+  };
+  return run_jobs(jobs, skip_done, run, nullptr);
+}
+
+int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable) {
+  const SignalForwarder signals;
+  const JobRunner run = [&](size_t index, const Job& job) {
+    return run_job_in_process(executable, index, job, signals);
+  };
+  return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); });
 }
 
 }  // namespace wt::app

@@ -19,9 +19,20 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
 // Whether a file parses as JSON with a top-level "jobs" key (a scene file has none).
 bool is_jobs_file(const std::string& path);
 
-// Runs every job, prints a summary table, returns the exit code (non-zero if any failed).
-// `skip_done`: jobs whose image exists are skipped (a batch resumed). A job stopped
-// by a signal stops the batch, whose exit code is then the job's.
+// Runs every job in this process, prints a summary table, returns the exit code
+// (non-zero if any failed). `skip_done`: jobs whose image exists are skipped (a batch
+// resumed). A job stopped by a signal stops the batch, whose exit code is then the
+// job's. A job that meets a sticky CUDA error loses this process's CUDA context: the
+// CUDA jobs after it (backend cuda or auto) fail at once with one line saying so, and
+// the CPU jobs still run.
 int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
+
+// `wavetrace batch`: the same, with each job run as `executable render ...` in a
+// process of its own (render_arguments), so that every job starts on a clean CUDA
+// context. The summary's figures come from a stats file the child writes (the job's
+// own, or a temporary one removed after it). SIGINT and SIGTERM sent to this process
+// are passed on to the running job, and the batch stops after it with 128 + the
+// signal; a job killed by another signal fails alone. This process never calls CUDA.
+int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable);
 
 }  // namespace wt::app

@@ -60,6 +60,19 @@ void set_setting(Job& job, SettingId id, int64_t value) {
   }
 }
 
+std::optional<int64_t> given_setting(const Job& job, SettingId id) {
+  if (const std::optional<int64_t>* o = render_override(job, id)) return *o;
+  static const Job defaults;
+  const auto unless_default = [](int64_t v, int64_t d) { return v == d ? std::nullopt : std::optional<int64_t>(v); };
+  switch (id) {
+    case SettingId::Warmup: return unless_default(job.warmup, defaults.warmup);
+    case SettingId::WaveSize: return unless_default(job.wave_size, defaults.wave_size);
+    case SettingId::Threads: return unless_default(job.threads, defaults.threads);
+    case SettingId::CheckpointEvery: return unless_default(job.checkpoint_every, defaults.checkpoint_every);
+    default: return std::nullopt;
+  }
+}
+
 namespace {
 
 RenderParams resolve_params(const Scene& scene, const Job& job) {
@@ -95,14 +108,11 @@ void print_profile(const RenderResult& r) {
   std::fprintf(stderr, r.live_per_bounce.size() > 40 ? " ...\n" : "\n");
 }
 
-// After a device failure: the next job must start on a clean device context.
+// After a device failure: an error that left the context usable is cleared; a sticky
+// one is said, since nothing more of CUDA can run in this process.
 void recover_device(JobOutcome& out) {
-  try {
-    out.device_reset = cuda::recover_after_error() == cuda::Recovery::Reset;
-    if (out.device_reset) out.message += "; the device was reset";
-  } catch (const DeviceError& e) {
-    out.message += std::string("; the device could not be reset: ") + e.what();
-  }
+  out.device_lost = cuda::recover_after_error() == cuda::Recovery::Lost;
+  if (out.device_lost) out.message += "; " + std::string(cuda::kContextLost);
 }
 
 }  // namespace
@@ -144,8 +154,8 @@ JobOutcome run_job(const Job& job) {
       // Short passes, so that a signal is answered within about 1/256 of the render.
       options.samples_per_pass = std::max(1, rp.spp / 256);
       signals.emplace();
-      auto last_write = std::chrono::steady_clock::now();
-      options.after_pass = [&, identity](int32_t samples, const FilmReader& film) {
+      options.after_pass = [&, identity, last_write = std::chrono::steady_clock::now()](
+                               int32_t samples, const FilmReader& film) mutable {
         const bool stop = signals->caught() != 0;
         const auto now = std::chrono::steady_clock::now();
         if (stop || (samples < rp.spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {

@@ -41,7 +41,9 @@ constexpr int kExitFailure = 1;
 struct JobOutcome {
   int exit_code = 0;
   std::string message;  // the one line that says why, when exit_code != 0
-  bool device_reset = false;  // the job failed on the device, and the device was reset after it
+  // The job failed on the device with a sticky error (an illegal address, a kernel that
+  // faulted): this process's CUDA context is lost, and no later CUDA work in it can run.
+  bool device_lost = false;
   RenderParams params{};
   LoadTimes load_times;
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
@@ -50,12 +52,15 @@ struct JobOutcome {
 };
 
 // Runs a job; never throws. Writes the image (and stats) only when the render and
-// both writes succeeded. After a device failure it leaves the device fit for the next
-// job (cuda::recover_after_error: a reset when the context was poisoned).
+// both writes succeeded. After a device failure that is not sticky it leaves the
+// device fit for the next job (cuda::recover_after_error); after a sticky one it says
+// that the context cannot be recovered and sets device_lost.
 JobOutcome run_job(const Job& job);
 
 // Sets a setting of the table (already checked against its range).
 void set_setting(Job& job, SettingId id, int64_t value);
+// A setting the job was given: its value, or none where the job keeps the default.
+std::optional<int64_t> given_setting(const Job& job, SettingId id);
 
 Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
 

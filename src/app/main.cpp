@@ -5,54 +5,19 @@
 
 #include "app/batch.hpp"
 #include "app/bench.hpp"
+#include "app/cli.hpp"
 #include "app/job.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
-namespace {
-
 using wt::app::Job;
-
-// The options that render and batch share; they fill `job`. Names, ranges and help
-// of the numeric settings come from the settings table.
-void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
-  for (const wt::Setting& s : wt::settings()) {
-    cmd.add_option_function<int64_t>(
-           s.flag, [&job, id = s.id](int64_t v) { wt::app::set_setting(job, id, v); }, s.help)
-        ->check(CLI::Range(s.lo, s.hi));
-  }
-  cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
-      ->check(CLI::IsMember(wt::backend_choices()));
-  cmd.add_option("--kernel", job.kernel, "the kernel: " + wt::listed(wt::kernel_names()))
-      ->check(CLI::IsMember(wt::kernel_names()));
-  cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
-      ->check(CLI::IsMember(wt::encoding_choices()));
-  cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
-}
-
-void set_encoding(Job& job, const std::string& encoding) {
-  job.encoding = encoding == "gamma2" ? wt::Encoding::Gamma2 : wt::Encoding::Srgb;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"wavetrace: a wavefront path tracer, with the megakernel kept for comparison"};
   app.require_subcommand(1);
 
-  Job job;
-  std::string encoding = "srgb";
-  bool quiet = false;
-  CLI::App* render = app.add_subcommand("render", "render one scene");
-  render->add_option("scene", job.scene, "scene file (JSON)")->required();
-  render->add_option("-o,--output", job.output, "image file: .png (8-bit) or .pfm (linear float)")->required();
-  render->add_option("--stats", job.stats, "write render statistics as JSON");
-  render->add_option("--checkpoint", job.checkpoint,
-                     "write the film's sums here every --checkpoint-every seconds and on SIGINT/SIGTERM; "
-                     "an existing checkpoint of the same render is resumed");
-  render->add_option("--resume", job.resume, "continue the render a checkpoint holds");
-  render->add_flag("-q,--quiet", quiet, "no progress line");
-  add_render_options(*render, job, encoding);
+  wt::app::RenderCommand render_command;
+  CLI::App* render = wt::app::add_render_command(app, render_command);
 
   Job batch_job;
   std::string batch_encoding = "srgb";
@@ -63,7 +28,7 @@ int main(int argc, char** argv) {
   batch->add_option("--output-dir", output_dir, "where scene files given directly are rendered to");
   bool skip_done = false;
   batch->add_flag("--resume", skip_done, "skip the jobs whose image exists (a batch resumed)");
-  add_render_options(*batch, batch_job, batch_encoding);
+  wt::app::add_render_options(*batch, batch_job, batch_encoding);
 
   wt::app::BenchOptions bench_options;
   CLI::App* bench = app.add_subcommand("bench", "time a grid of scenes x configurations x kernels");
@@ -90,8 +55,7 @@ int main(int argc, char** argv) {
   }
 
   if (*render) {
-    set_encoding(job, encoding);
-    job.progress = !quiet;
+    const Job job = render_command.parsed();
     wt::app::JobOutcome o = wt::app::run_job(job);
     if (o.exit_code != 0) {
       std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
@@ -121,7 +85,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  set_encoding(batch_job, batch_encoding);
+  wt::app::set_encoding(batch_job, batch_encoding);
   std::vector<wt::app::PlannedJob> jobs;
   try {
     // One input that is a jobs file; otherwise every input is a scene file.
@@ -139,5 +103,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     return wt::app::kExitBadInput;
   }
-  return wt::app::run_batch(jobs, skip_done);
+  // Each job runs as `wavetrace render` in a process of its own: a clean CUDA context
+  // for every job, whatever the one before it did to its own.
+  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe");
 }

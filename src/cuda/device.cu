@@ -48,11 +48,7 @@ Recovery recover_after_error() {
   // out a fault of work still queued.
   cudaError_t err = cudaDeviceSynchronize();
   if (err == cudaSuccess) err = cudaGetLastError();
-  if (err == cudaSuccess) return Recovery::Clean;
-  WT_CUDA(cudaDeviceReset(), "device reset");
-  WT_CUDA(cudaFree(nullptr), "device reset");  // makes the new context now, or says why it cannot
-  WT_CUDA(cudaDeviceSynchronize(), "device reset");
-  return Recovery::Reset;
+  return err == cudaSuccess ? Recovery::Clean : Recovery::Lost;
 }
 
 DeviceInfo device_info() {

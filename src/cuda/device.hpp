@@ -39,15 +39,19 @@ void check_allocation(int code, size_t bytes, const char* stage);
 
 enum class Recovery {
   Clean,  // the context was usable: any error left by the failed call is cleared
-  Reset,  // the context was poisoned (a sticky error: an illegal address, a kernel that
-          // faulted) and the device was reset, freeing all this process held on it
+  Lost,   // the context is poisoned (a sticky error: an illegal address, a kernel that
+          // faulted): every later CUDA call of this process fails; only a new process
+          // gets a clean context (cudaDeviceReset does not bring it back: on the H100
+          // every call after it fails with cudaErrorDevicesUnavailable)
 };
 
-// After a job failed with a DeviceError, makes the device fit for the next job. A
-// reset destroys every allocation, stream and event of the process on the device:
-// call it only when nothing of the failed job is still held. Throws CudaError when the
-// device is still unusable after the reset.
+// After a job failed with a DeviceError, finds out whether the device can run the next
+// job in this process, and clears an error that did not poison the context.
 Recovery recover_after_error();
+
+// What a job that met a sticky error adds to its line.
+inline constexpr const char* kContextLost =
+    "the CUDA context of this process cannot be recovered (a sticky error; a new process gets a clean one)";
 
 }  // namespace wt::cuda
 

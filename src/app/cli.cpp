@@ -1,0 +1,70 @@
+#include "app/cli.hpp"
+
+#include "render/settings.hpp"
+#include "scene/json_reader.hpp"
+
+namespace wt::app {
+
+void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
+  for (const Setting& s : settings()) {
+    cmd.add_option_function<int64_t>(
+           s.flag, [&job, id = s.id](int64_t v) { set_setting(job, id, v); }, s.help)
+        ->check(CLI::Range(s.lo, s.hi));
+  }
+  cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
+      ->check(CLI::IsMember(backend_choices()));
+  cmd.add_option("--kernel", job.kernel, "the kernel: " + listed(kernel_names()))
+      ->check(CLI::IsMember(kernel_names()));
+  cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
+      ->check(CLI::IsMember(encoding_choices()));
+  cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
+}
+
+void set_encoding(Job& job, const std::string& encoding) {
+  job.encoding = encoding == "gamma2" ? Encoding::Gamma2 : Encoding::Srgb;
+}
+
+Job RenderCommand::parsed() const {
+  Job j = job;
+  set_encoding(j, encoding);
+  j.progress = !quiet;
+  return j;
+}
+
+CLI::App* add_render_command(CLI::App& app, RenderCommand& cmd) {
+  CLI::App* render = app.add_subcommand("render", "render one scene");
+  render->add_option("scene", cmd.job.scene, "scene file (JSON)")->required();
+  render->add_option("-o,--output", cmd.job.output, "image file: .png (8-bit) or .pfm (linear float)")->required();
+  render->add_option("--stats", cmd.job.stats, "write render statistics as JSON");
+  render->add_option("--checkpoint", cmd.job.checkpoint,
+                     "write the film's sums here every --checkpoint-every seconds and on SIGINT/SIGTERM; "
+                     "an existing checkpoint of the same render is resumed");
+  render->add_option("--resume", cmd.job.resume, "continue the render a checkpoint holds");
+  render->add_flag("-q,--quiet", cmd.quiet, "no progress line");
+  add_render_options(*render, cmd.job, cmd.encoding);
+  return render;
+}
+
+std::vector<std::string> render_arguments(const Job& job) {
+  // "--name=value", so that a value starting with '-' is not taken for an option.
+  std::vector<std::string> args = {"render", "--output=" + job.output};
+  const auto add = [&](const char* flag, const std::string& value) {
+    if (!value.empty()) args.push_back(std::string(flag) + "=" + value);
+  };
+  add("--stats", job.stats);
+  add("--checkpoint", job.checkpoint);
+  add("--resume", job.resume);
+  for (const Setting& s : settings()) {
+    if (const std::optional<int64_t> v = given_setting(job, s.id)) add(s.flag, std::to_string(*v));
+  }
+  add("--backend", job.backend);
+  add("--kernel", job.kernel);
+  add("--encoding", encoding_choices()[job.encoding == Encoding::Srgb ? 0 : 1]);
+  if (!job.progress) args.push_back("--quiet");
+  if (job.profile) args.push_back("--profile");
+  args.push_back("--");  // the scene, whatever its name
+  args.push_back(job.scene);
+  return args;
+}
+
+}  // namespace wt::app

@@ -1,0 +1,211 @@
+// `wavetrace batch` runs each job as `wavetrace render` in a process of its own
+// (run_batch_in_processes). Here: a job becomes a command line that parses back into
+// the same job, and the batch's handling of its children, with small shell scripts
+// standing in for the program (tests/command/ runs the real binary).
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <tuple>
+
+#include "app/batch.hpp"
+#include "app/cli.hpp"
+
+namespace wt::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Every field of a Job.
+auto fields(const Job& j) {
+  return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
+                  j.kernel, j.warmup, j.wave_size, j.threads, j.checkpoint, j.resume, j.checkpoint_every, j.encoding,
+                  j.progress, j.profile);
+}
+
+// Parses a command line (after the program name) as main does.
+Job parse_render(const std::vector<std::string>& args) {
+  CLI::App app;
+  RenderCommand cmd;
+  add_render_command(app, cmd);
+  std::vector<std::string> text = {"wavetrace"};
+  text.insert(text.end(), args.begin(), args.end());
+  std::vector<const char*> argv;
+  for (const std::string& a : text) argv.push_back(a.c_str());
+  app.parse(static_cast<int>(argv.size()), argv.data());
+  return cmd.parsed();
+}
+
+TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
+  Job every;
+  every.scene = "-scene with spaces.json";  // a leading '-' must not read as an option
+  every.output = "-out.pfm";
+  every.stats = "s.json";
+  every.width = 33;
+  every.height = 17;
+  every.spp = 5;
+  every.depth = 7;
+  every.roulette_depth = 0;
+  every.seed = 4294967295;
+  every.backend = "cuda";
+  every.kernel = "wavefront-unsorted";
+  every.warmup = 3;
+  every.wave_size = 4096;
+  every.threads = 2;
+  every.checkpoint = "c.ckpt";
+  every.resume = "r.ckpt";
+  every.checkpoint_every = 9;
+  every.encoding = Encoding::Gamma2;
+  every.progress = false;
+  every.profile = true;
+  Job defaults;
+  defaults.scene = "s.json";
+  defaults.output = "o.png";
+  for (const Job& job : {every, defaults}) {
+    const std::vector<std::string> args = render_arguments(job);
+    EXPECT_EQ(args.front(), "render");
+    const Job back = parse_render(args);
+    EXPECT_TRUE(fields(back) == fields(job)) << job.scene;
+  }
+  // A default job's settings stay unset, so that the scene's own apply.
+  EXPECT_FALSE(parse_render({"render", "-o", "o.png", "s.json"}).width.has_value());
+}
+
+class BatchProcessTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("wavetrace_batch_process_" + std::to_string(::getpid()) + "_" +
+                                        testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // A shell script standing in for the program: `body` runs with the job's arguments.
+  std::string script(const std::string& body) const {
+    const std::string p = (dir_ / "fake-wavetrace").string();
+    std::ofstream(p) << "#!/bin/sh\n" << body << "\n";
+    ::chmod(p.c_str(), 0755);
+    return p;
+  }
+
+  std::vector<PlannedJob> jobs(int n) const {
+    std::vector<PlannedJob> list;
+    for (int i = 0; i < n; ++i) {
+      Job j;
+      j.scene = "s.json";
+      j.output = (dir_ / ("out" + std::to_string(i) + ".png")).string();
+      list.push_back({j, ""});
+    }
+    return list;
+  }
+
+  // Runs the batch with the script; its exit code, and what it wrote to stdout and stderr.
+  std::tuple<int, std::string, std::string> batch(const std::string& exe, const std::vector<PlannedJob>& list,
+                                                  bool skip_done = false) const {
+    testing::internal::CaptureStdout();
+    testing::internal::CaptureStderr();
+    const int code = run_batch_in_processes(list, skip_done, exe);
+    std::string out = testing::internal::GetCapturedStdout();
+    return {code, out, testing::internal::GetCapturedStderr()};
+  }
+
+  fs::path dir_;
+};
+
+size_t count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+TEST_F(BatchProcessTest, AChildsLastLineIsItsMessageAndItsOtherOutputIsForwarded) {
+  const std::string exe = script(R"(echo "progress" >&2
+echo "wavetrace: a notice" >&2
+echo "wavetrace: the job failed because of X" >&2
+exit 2)");
+  const auto [code, out, err] = batch(exe, jobs(2));
+  EXPECT_EQ(code, kExitFailure);
+  EXPECT_EQ(count(out, "FAILED: the job failed because of X"), 2u) << out;
+  EXPECT_NE(out.find("2 jobs: 0 ok, 2 failed"), std::string::npos) << out;
+  // Each line once: the last one from the batch, the others forwarded as they came.
+  EXPECT_EQ(count(err, "wavetrace: the job failed because of X\n"), 2u) << err;
+  EXPECT_EQ(count(err, "wavetrace: a notice\n"), 2u) << err;
+  EXPECT_EQ(count(err, "progress\n"), 2u) << err;
+}
+
+TEST_F(BatchProcessTest, AChildKilledByASignalFailsItsJobAloneAndSaysSo) {
+  const auto [code, out, err] = batch(script("kill -SEGV $$"), jobs(2));
+  EXPECT_EQ(code, kExitFailure);
+  const std::string line = "the job's process was killed by signal " + std::to_string(SIGSEGV) + " (" +
+                           strsignal(SIGSEGV) + ")";
+  EXPECT_EQ(count(out, "FAILED: " + line), 2u) << out;
+  EXPECT_EQ(count(err, "wavetrace: " + line), 2u) << err;
+}
+
+TEST_F(BatchProcessTest, ExitWithoutALineIsReportedWithItsCode) {
+  const auto [code, out, err] = batch(script("exit 3"), jobs(1));
+  EXPECT_EQ(code, kExitFailure);
+  EXPECT_NE(out.find("FAILED: the job's process exited with 3 without saying why"), std::string::npos) << out;
+}
+
+TEST_F(BatchProcessTest, TheJobGetsItsArgumentsAndAStatsFileThatIsRemovedAfterwards) {
+  // The child records its arguments, and writes the stats file it was given.
+  const std::string exe = script(R"(printf '%s\n' "$@" > ")" + (dir_ / "args").string() + R"("
+for a in "$@"; do case "$a" in --stats=*) printf '%s' '{"settings": {"width": 7, "height": 5, "spp": 3, "depth": 2},
+ "backend": "cpu", "kernel": "wavefront", "seconds": 2.0, "rays": 8000000}' > "${a#--stats=}"; echo "${a#--stats=}" > ")" + (dir_ / "stats-path").string() + R"(";; esac; done)");
+  std::vector<PlannedJob> list = jobs(1);
+  list[0].job.seed = 9;
+  const auto [code, out, err] = batch(exe, list);
+  EXPECT_EQ(code, 0) << err;
+  std::vector<std::string> args;
+  std::ifstream in(dir_ / "args");
+  for (std::string a; std::getline(in, a);) args.push_back(a);
+  EXPECT_EQ(args, render_arguments([&] {
+              Job j = list[0].job;
+              j.stats = args.size() > 2 ? args[2].substr(std::string("--stats=").size()) : "";
+              return j;
+            }()));
+  std::string stats;
+  std::getline(std::ifstream(dir_ / "stats-path"), stats);
+  EXPECT_EQ(fs::path(stats).extension(), ".json");
+  EXPECT_FALSE(fs::exists(stats));  // the temporary stats file is gone
+  EXPECT_NE(out.find("7x5 3spp d2"), std::string::npos) << out;
+  EXPECT_NE(out.find("cpu/wavefront"), std::string::npos) << out;
+  EXPECT_NE(out.find("    2.000       4.00  ok -> "), std::string::npos) << out;
+}
+
+TEST_F(BatchProcessTest, ResumeSkipsJobsWhoseImageExists) {
+  std::vector<PlannedJob> list = jobs(2);
+  std::ofstream(list[0].job.output) << "done";
+  const auto [code, out, err] = batch(script("exit 0"), list, true);
+  EXPECT_EQ(code, 0);
+  EXPECT_NE(out.find("skipped: " + list[0].job.output + " exists"), std::string::npos) << out;
+  EXPECT_EQ(count(err, "[2/2]"), 1u) << err;
+}
+
+// SIGTERM sent to the batch reaches the running job (the script sends it to its
+// parent, the batch, and waits for it to come back); the batch stops after that job
+// with 128 + the signal, whether the job writes a checkpoint and exits or dies of it.
+TEST_F(BatchProcessTest, SigtermToTheBatchIsPassedOnToTheJobAndStopsTheBatch) {
+  const std::string checkpointed = script(R"(trap 'echo "wavetrace: interrupted by SIGTERM; checkpoint written" >&2; exit 143' TERM
+kill -TERM $PPID
+while :; do sleep 1; done)");
+  auto [code, out, err] = batch(checkpointed, jobs(3));
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_NE(out.find("FAILED: interrupted by SIGTERM; checkpoint written"), std::string::npos) << out;
+  EXPECT_NE(out.find("1 jobs: 0 ok, 1 failed; interrupted, 2 not run"), std::string::npos) << out;
+
+  std::tie(code, out, err) = batch(script("kill -TERM $PPID\nwhile :; do sleep 1; done"), jobs(3));
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_NE(out.find("FAILED: the job's process was killed by SIGTERM"), std::string::npos) << out;
+  EXPECT_NE(out.find("interrupted, 2 not run"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace wt::app
