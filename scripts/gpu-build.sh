@@ -6,7 +6,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 export WAVETRACE_BUILD=${WAVETRACE_BUILD:-$root/build}
 bash "$root/scripts/build.sh"
 mkdir -p "$root/.gpu/bin"
-cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD/wavetrace_tests" "$root/.gpu/bin/"
+cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$root/.gpu/bin/"
 commit=$(git -C "$root" rev-parse HEAD)
 dirty=$(git -C "$root" status --porcelain --untracked-files=no | grep -q . && echo true || echo false)
 printf '{"commit": "%s", "dirty": %s}\n' "$commit" "$dirty" >"$root/.gpu/bin/build-info.json"

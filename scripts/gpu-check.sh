@@ -24,7 +24,8 @@ passed=0 failed=0 skipped=0 broken=()
 for t in "$bin"/*_tests; do
   [[ -x "$t" ]] || continue
   log="$out/$(basename "$t").log"
-  "$t" --gtest_brief=0 >"$log" 2>&1
+  # Test binaries that drive the command itself take its path; the others ignore it.
+  "$t" --gtest_brief=0 "$bin/wavetrace" >"$log" 2>&1
   rc=$?
   p=$(grep -oP '^\[  PASSED  \] \K[0-9]+' "$log" | tail -1)
   f=$(grep -oP '^\[  FAILED  \] \K[0-9]+(?= tests?, listed below)' "$log" | tail -1)
@@ -56,7 +57,7 @@ if ((sanitize)); then
     # The test that sends itself SIGTERM is left out: compute-sanitizer takes the
     # signal for its own and ends the run.
     for t in "$bin"/*_tests; do
-      [[ -x "$t" ]] && runs+=("$t --gtest_brief=1 --gtest_filter=-*Sigterm*")
+      [[ -x "$t" ]] && runs+=("$t --gtest_brief=1 --gtest_filter=-*Sigterm* $bin/wavetrace")
     done
     for kernel in $kernels; do
       runs+=("$bin/wavetrace render scenes/seed57.json -o $out/sanitize-$kernel.png --width 160 --height 90 --spp 4 --backend cuda --kernel $kernel -q")
