@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <thread>
 #include <new>
 #include <nlohmann/json.hpp>
 
@@ -122,6 +123,15 @@ JobOutcome run_job(const Job& job) {
   try {
     check_output_path(job.output);
     if (!job.stats.empty()) check_output_path_for_text(job.stats);
+    // The CUDA context starts while the scene loads.
+    std::thread context;
+    if (job.backend != "cpu") context = std::thread(cuda::start_context);
+    struct Joined {
+      std::thread& t;
+      ~Joined() {
+        if (t.joinable()) t.join();
+      }
+    } joined{context};
     Scene scene = load_scene(job.scene);
     out.load_times = scene.load_times;
     RenderOptions options;

@@ -23,6 +23,10 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 
 }  // namespace
 
+void start_context() {
+  if (device_count() > 0 && cudaFree(nullptr) != cudaSuccess) cudaGetLastError();
+}
+
 void check(int code, const char* call, const char* stage) {
   if (code == cudaSuccess) return;
   auto err = static_cast<cudaError_t>(code);

@@ -17,6 +17,11 @@ struct CudaError : DeviceError {
 // Number of usable CUDA devices; 0 where there is no driver or no device.
 int device_count();
 
+// Starts the CUDA runtime and the current device's context, which takes a good
+// part of a second, so that it can run while a scene loads. Quiet where there is no
+// device: the render that needs one says so.
+void start_context();
+
 struct DeviceInfo {
   std::string name;
   int sm_count = 0;
