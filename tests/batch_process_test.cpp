@@ -15,6 +15,7 @@
 
 #include "app/batch.hpp"
 #include "app/cli.hpp"
+#include "test_support.hpp"
 
 namespace wt::app {
 namespace {
@@ -78,13 +79,6 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
 
 class BatchProcessTest : public testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("wavetrace_batch_process_" + std::to_string(::getpid()) + "_" +
-                                        testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // A shell script standing in for the program: `body` runs with the job's arguments.
   std::string script(const std::string& body) const {
@@ -115,7 +109,8 @@ class BatchProcessTest : public testing::Test {
     return {code, out, testing::internal::GetCapturedStderr()};
   }
 
-  fs::path dir_;
+  test::TestFolder folder_;
+  const fs::path dir_ = folder_.root();
 };
 
 size_t count(const std::string& text, const std::string& what) {

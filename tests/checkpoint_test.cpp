@@ -23,13 +23,8 @@ namespace fs = std::filesystem;
 class CheckpointTest : public testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("wavetrace_checkpoint_test_" + std::to_string(::getpid()) + "_" +
-                                        testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
     scene_ = test::repo_path("scenes/quick.json");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
@@ -76,7 +71,8 @@ class CheckpointTest : public testing::Test {
     return j;
   }
 
-  fs::path dir_;
+  test::TestFolder folder_;
+  const fs::path dir_ = folder_.root();
   std::string scene_;
 };
 

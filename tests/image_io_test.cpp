@@ -76,13 +76,6 @@ std::string write_error_with_file_size_limit(unsigned long long limit, const std
 
 class FullDisk : public testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("wavetrace_full_disk_" + std::to_string(::getpid()) + "_" +
-                                        testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::vector<std::string> files() const {
@@ -92,7 +85,8 @@ class FullDisk : public testing::Test {
   }
   static std::string efbig(const std::string& path) { return path + ": cannot write (" + std::strerror(EFBIG) + ")"; }
 
-  fs::path dir_;
+  test::TestFolder folder_;
+  const fs::path dir_ = folder_.root();
 };
 
 // 64 x 64 pixels of noise: a 12 KiB PNG (noise does not compress), a 48 KiB PFM.

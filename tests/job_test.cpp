@@ -24,13 +24,6 @@ namespace fs = std::filesystem;
 
 class JobTest : public testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("wavetrace_job_test_" + std::to_string(::getpid()) + "_" +
-                                        testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
@@ -60,7 +53,8 @@ class JobTest : public testing::Test {
     return n == names.size();
   }
 
-  fs::path dir_;
+  test::TestFolder folder_;
+  const fs::path dir_ = folder_.root();
 };
 
 const char* kTinyScene = R"({

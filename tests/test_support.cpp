@@ -26,6 +26,21 @@ std::string repo_root() {
 
 std::string repo_path(const std::string& relative) { return repo_root() + "/" + relative; }
 
+TestFolder::TestFolder() {
+  const testing::TestInfo* test = testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string("wavetrace_") + test->test_suite_name() + "_" + test->name() + "_" +
+                     std::to_string(::getpid());
+  for (char& c : name) c = (c == '/') ? '_' : c;
+  root_ = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(root_);
+  std::filesystem::create_directories(root_);
+}
+
+TestFolder::~TestFolder() {
+  std::error_code ignored;
+  std::filesystem::remove_all(root_, ignored);
+}
+
 bool cuda_available() { return wt::cuda::device_count() > 0; }
 
 // "PF", width, height, -1.0 (little-endian), then the rows bottom first.

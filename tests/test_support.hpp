@@ -3,11 +3,26 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
 
 namespace wt::test {
+
+// A fresh folder of the running test's own (named after it and the process),
+// removed with it.
+class TestFolder {
+ public:
+  TestFolder();
+  ~TestFolder();
+  TestFolder(const TestFolder&) = delete;
+  TestFolder& operator=(const TestFolder&) = delete;
+  const std::filesystem::path& root() const { return root_; }
+
+ private:
+  std::filesystem::path root_;
+};
 
 // The repository root, found from WAVETRACE_ROOT or by walking up from the working
 // directory to the folder that holds scenes/; test data is read relative to it, so
