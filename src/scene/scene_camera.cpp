@@ -1,0 +1,60 @@
+// Scene files: the camera, the sky and the render settings (docs/scene-format.md).
+#include "render/settings.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace wt {
+
+void SceneReader::read_camera(const json& j, const JsonPath& path) {
+  check_keys(j, path, {"look_from", "look_at", "up", "vfov", "aperture", "focus_distance"});
+  CameraSpec& c = scene_.camera;
+  c.look_from = triple(required(j, path, "look_from"), path / "look_from");
+  c.look_at = triple(required(j, path, "look_at"), path / "look_at");
+  if (j.contains("up")) c.up = triple(j["up"], path / "up");
+  if (j.contains("vfov")) {
+    c.vfov_degrees = number(j["vfov"], path / "vfov");
+    if (!(c.vfov_degrees > 0.0f && c.vfov_degrees < 180.0f)) {
+      fail_at(path / "vfov", "must be in (0, 180) degrees (got " + j["vfov"].dump() + ")");
+    }
+  }
+  if (j.contains("aperture")) c.aperture = non_negative(j["aperture"], path / "aperture");
+  if (j.contains("focus_distance")) c.focus_distance = positive(j["focus_distance"], path / "focus_distance");
+
+  // The camera frame is built from cross(up, view); it is undefined when they are
+  // parallel and numerically meaningless when nearly so.
+  glm::dvec3 view = glm::dvec3(c.look_at) - glm::dvec3(c.look_from);
+  glm::dvec3 up(c.up);
+  if (glm::length(view) == 0.0) fail_at(path / "look_at", "must differ from look_from");
+  if (glm::length(up) == 0.0) fail_at(path / "up", "must not be the zero vector");
+  if (glm::length(glm::cross(up, view)) <= 1e-4 * glm::length(up) * glm::length(view)) {
+    fail_at(path / "up", std::string("must not be parallel to the view direction look_at - look_from") +
+                                   (j.contains("up") ? "" : " (up defaults to [0, 1, 0])"));
+  }
+}
+
+void SceneReader::read_sky(const json& j, const JsonPath& path) {
+  size_t type = type_of(j, path, "sky", {"gradient", "uniform"});
+  if (type == 0) {
+    check_keys(j, path, {"type", "horizon", "zenith"}, "gradient");
+    scene_.sky.kind = SkyKind::Gradient;
+    if (j.contains("horizon")) scene_.sky.horizon = radiance(j["horizon"], path / "horizon");
+    if (j.contains("zenith")) scene_.sky.zenith = radiance(j["zenith"], path / "zenith");
+  } else {
+    check_keys(j, path, {"type", "radiance"}, "uniform");
+    scene_.sky.kind = SkyKind::Uniform;
+    scene_.sky.horizon = radiance(required(j, path, "radiance"), path / "radiance");
+    scene_.sky.zenith = scene_.sky.horizon;
+  }
+}
+
+void SceneReader::read_render(const json& j, const JsonPath& path) {
+  std::vector<std::string> keys;
+  for (SettingId id : render_settings()) keys.push_back(setting(id).key);
+  check_keys(j, path, keys);
+  for (SettingId id : render_settings()) {
+    const Setting& s = setting(id);
+    auto it = j.find(s.key);
+    if (it != j.end()) set_param(scene_.render, id, integer(*it, path / s.key, s.lo, s.hi));
+  }
+}
+
+}  // namespace wt
