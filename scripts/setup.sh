@@ -2,7 +2,8 @@
 # Installs the Debian packages wavetrace builds against. Safe to run again:
 # packages already present are left alone and nothing is fetched.
 set -euo pipefail
-packages=(cmake ninja-build g++ libglm-dev nlohmann-json3-dev libstb-dev libcli11-dev libgtest-dev zlib1g-dev)
+packages=(cmake ninja-build g++ libglm-dev nlohmann-json3-dev libstb-dev libcli11-dev libgtest-dev zlib1g-dev
+  libtinyobjloader-dev libtinygltf-dev)
 if [[ "${WAVETRACE_WITH_PLOTS:-0}" == 1 ]]; then
   packages+=(python3-matplotlib)
 fi

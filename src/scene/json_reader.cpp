@@ -153,7 +153,7 @@ json parse_json(const std::string& text, const std::string& source) {
   return builder.take();
 }
 
-json read_json_file(const std::string& path, const char* what) {
+std::string read_file(const std::string& path, const char* what) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw SceneError(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
   std::string text;
@@ -164,8 +164,10 @@ json read_json_file(const std::string& path, const char* what) {
   int err = errno;
   std::fclose(f);
   if (failed) throw SceneError(path + ": cannot read " + what + " (" + std::strerror(err) + ")");
-  return parse_json(text, path);
+  return text;
 }
+
+json read_json_file(const std::string& path, const char* what) { return parse_json(read_file(path, what), path); }
 
 std::string listed(const std::vector<std::string>& names) {
   std::string out;

@@ -40,6 +40,10 @@ class JsonPath {
 // SceneError "<source>: malformed JSON: ..." or "<source>: /path: duplicate key".
 json parse_json(const std::string& text, const std::string& source);
 
+// Reads a whole file; `what` names the kind of file in the message when it cannot
+// be opened or read: SceneError "<path>: cannot open <what> (<reason>)".
+std::string read_file(const std::string& path, const char* what);
+
 // Reads a whole file and parses it as above; `what` names the kind of file in the
 // message when it cannot be read ("scene file", "jobs file", ...).
 json read_json_file(const std::string& path, const char* what);

@@ -1,0 +1,12 @@
+// The mesh libraries of the Debian packages libtinyobjloader-dev and libtinygltf-dev,
+// configured alike in every file that includes them (their inline code depends on
+// the configuration). tinygltf: no image decoding or writing and no reading of image
+// files (mesh_load.cpp keeps image file names only); it parses JSON with
+// nlohmann-json, as wavetrace does.
+#pragma once
+
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+#include <tiny_obj_loader.h>

@@ -1,0 +1,571 @@
+// Mesh files to TriangleMesh. The libraries parse (and tinyobjloader triangulates);
+// this file checks what they return (indices, accessor bounds, non-finite values),
+// drops degenerate triangles and maps materials (docs/scene-format.md, "Meshes").
+#include "scene/mesh_load.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <functional>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <limits>
+#include <sstream>
+#include <unordered_map>
+
+#include "scene/json_reader.hpp"
+#include "scene/mesh_libraries.hpp"
+#include "scene/scene.hpp"
+
+namespace wt {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) { throw SceneError(path + ": " + what); }
+
+bool finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The first non-empty line of a library's message, without its trailing newline.
+std::string first_line(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find_first_not_of(" \t\r.") != std::string::npos) return line;
+  }
+  return text;
+}
+
+// Appends vertices and triangles, dropping the triangles that cannot be traced.
+class MeshBuilder {
+ public:
+  explicit MeshBuilder(TriangleMesh& mesh) : m_(mesh) {}
+
+  uint32_t add_vertex(const vec3& p, const vec3* n, const vec2* uv) {
+    if (m_.positions.size() >= std::numeric_limits<uint32_t>::max()) fail(m_.source, "more than 2^32 - 1 vertices");
+    if (n) {
+      if (!finite(*n) || glm::length(*n) == 0.0f) {
+        fail(m_.source, "vertex " + std::to_string(m_.positions.size()) + " has a zero or non-finite normal");
+      }
+    } else {
+      missing_normal_ = true;
+    }
+    if (uv) {
+      if (!std::isfinite(uv->x) || !std::isfinite(uv->y)) {
+        fail(m_.source, "vertex " + std::to_string(m_.positions.size()) + " has a non-finite texture coordinate");
+      }
+    } else {
+      missing_uv_ = true;
+    }
+    m_.positions.push_back(p);
+    m_.normals.push_back(n ? glm::normalize(*n) : vec3(0.0f));
+    m_.uvs.push_back(uv ? *uv : vec2(0.0f));
+    return static_cast<uint32_t>(m_.positions.size() - 1);
+  }
+
+  // Whether a triangle over these corners would be kept (counting it if not).
+  bool keep(const vec3& a, const vec3& b, const vec3& c) {
+    if (!finite(a) || !finite(b) || !finite(c)) {
+      ++m_.dropped_nan;
+      return false;
+    }
+    vec3 cross = glm::cross(b - a, c - a);
+    if (!finite(cross) || glm::length(cross) == 0.0f) {
+      ++m_.dropped_degenerate;
+      return false;
+    }
+    return true;
+  }
+
+  void add_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t material) {
+    m_.triangles.push_back({a, b, c});
+    m_.triangle_material.push_back(material);
+  }
+
+  // Normals and UVs are kept only where every vertex has them; unused materials
+  // stay (their indices are the file's).
+  void finish() {
+    if (missing_normal_) m_.normals.clear();
+    if (missing_uv_) m_.uvs.clear();
+    if (m_.triangles.empty()) {
+      size_t dropped = m_.dropped_degenerate + m_.dropped_nan;
+      fail(m_.source, dropped ? "no triangles left (" + std::to_string(m_.dropped_degenerate) + " degenerate and " +
+                                    std::to_string(m_.dropped_nan) + " non-finite dropped)"
+                              : std::string("has no triangles"));
+    }
+  }
+
+ private:
+  TriangleMesh& m_;
+  bool missing_normal_ = false;
+  bool missing_uv_ = false;
+};
+
+// The material appended for faces the file gives none, once.
+uint32_t default_material(TriangleMesh& mesh, int64_t& index, const std::function<MeshMaterial()>& make) {
+  if (index < 0) {
+    index = static_cast<int64_t>(mesh.materials.size());
+    mesh.materials.push_back(make());
+  }
+  return static_cast<uint32_t>(index);
+}
+
+// Checks a material's colour and returns it: in [0, 1] for an albedo, >= 0 for an emission.
+vec3 checked_colour(const std::string& path, const std::string& material, const char* field, const double* c,
+                    bool radiance) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(c[i]) || c[i] < 0.0 || (!radiance && c[i] > 1.0) || c[i] > std::numeric_limits<float>::max()) {
+      fail(path, "material '" + material + "': " + field + " must be 3 numbers " +
+                     (radiance ? "no less than 0" : "in [0, 1]"));
+    }
+  }
+  return vec3(static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]));
+}
+
+vec3 checked_colour(const std::string& path, const std::string& material, const char* field, const float* c,
+                    bool radiance) {
+  const double d[3] = {c[0], c[1], c[2]};
+  return checked_colour(path, material, field, d, radiance);
+}
+
+Material make_material(MaterialKind kind, vec3 albedo, float fuzz, float ior, vec3 emission) {
+  Material m{};
+  m.kind = kind;
+  m.texture = -1;
+  m.albedo = kind == MaterialKind::Emissive ? vec3(0.0f) : albedo;
+  m.fuzz = kind == MaterialKind::Metal ? std::clamp(fuzz, 0.0f, 1.0f) : 0.0f;
+  m.ior = kind == MaterialKind::Dielectric || kind == MaterialKind::Coated ? ior : 1.0f;
+  m.emission = kind == MaterialKind::Emissive ? emission : vec3(0.0f);
+  m.sort_key = material_sort_key(kind, -1);
+  return m;
+}
+
+bool textured(MaterialKind kind) {
+  return kind == MaterialKind::Lambertian || kind == MaterialKind::Metal || kind == MaterialKind::Coated;
+}
+
+// ---- Wavefront OBJ + MTL ----
+
+MeshMaterial map_mtl(const tinyobj::material_t& t, const fs::path& dir, const std::string& path) {
+  const std::string& name = t.name;
+  vec3 kd = checked_colour(path, name, "Kd", t.diffuse, false);
+  vec3 ks = checked_colour(path, name, "Ks", t.specular, false);
+  vec3 ke = checked_colour(path, name, "Ke", t.emission, true);
+  if (!std::isfinite(t.shininess) || t.shininess < 0.0f) fail(path, "material '" + name + "': Ns must be >= 0");
+  if (!std::isfinite(t.ior) || t.ior <= 0.0f) fail(path, "material '" + name + "': Ni must be > 0");
+  if (!std::isfinite(t.dissolve) || t.dissolve < 0.0f || t.dissolve > 1.0f) {
+    fail(path, "material '" + name + "': d must be in [0, 1]");
+  }
+  // Ni of 1 (or less) is the MTL default, meaning "not given": a coat or a glass gets 1.5.
+  float ior = t.ior > 1.0f ? t.ior : 1.5f;
+  auto max3 = [](vec3 v) { return std::max(v.x, std::max(v.y, v.z)); };
+  MeshMaterial out;
+  out.name = name;
+  if (max3(ke) > 0.0f) {
+    out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, ke);
+  } else if (t.dissolve < 1.0f) {
+    out.material = make_material(MaterialKind::Dielectric, vec3(1.0f), 0.0f, ior, vec3(0.0f));
+  } else if (max3(ks) > 0.0f && max3(kd) == 0.0f) {
+    // Phong exponent to roughness: sqrt(2 / (Ns + 2)).
+    out.material = make_material(MaterialKind::Metal, ks, std::sqrt(2.0f / (t.shininess + 2.0f)), 1.0f, vec3(0.0f));
+  } else if (max3(ks) > 0.0f) {
+    out.material = make_material(MaterialKind::Coated, kd, 0.0f, ior, vec3(0.0f));
+  } else {
+    out.material = make_material(MaterialKind::Lambertian, kd, 0.0f, 1.0f, vec3(0.0f));
+  }
+  if (!t.diffuse_texname.empty() && textured(out.material.kind)) {
+    out.albedo_map = (dir / t.diffuse_texname).lexically_normal().string();
+  }
+  return out;
+}
+
+// (position, normal, uv) indices of an OBJ corner, the key of one mesh vertex.
+struct CornerHash {
+  size_t operator()(const std::array<int, 3>& k) const {
+    return std::hash<int64_t>()((static_cast<int64_t>(k[0]) << 32) ^ (static_cast<int64_t>(k[1]) << 16) ^ k[2]);
+  }
+};
+
+void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) {
+  const std::string& path = mesh.source;
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warn, err;
+  std::istringstream in(text);
+  tinyobj::MaterialFileReader mtl(dir.empty() ? std::string() : dir.string() + "/");
+  bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &mtl, /*triangulate=*/true,
+                             /*default_vcols_fallback=*/false);
+  if (!ok || !err.empty()) fail(path, "malformed OBJ: " + first_line(err.empty() ? warn : err));
+  // tinyobjloader reports a missing MTL file, an unknown material name and indices
+  // out of range as warnings and goes on; here they are errors. A face of fewer than
+  // three corners is a degenerate triangle.
+  std::istringstream warnings(warn);
+  for (std::string line; std::getline(warnings, line);) {
+    while (!line.empty() && line.front() == '.') line.erase(0, 1);  // its "Degenerated face found\n."
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    if (line.find("Degenerated face found") != std::string::npos) {
+      ++mesh.dropped_degenerate;
+      continue;
+    }
+    fail(path, "malformed OBJ: " + line);
+  }
+
+  for (const tinyobj::material_t& t : materials) mesh.materials.push_back(map_mtl(t, dir, path));
+  int64_t fallback = -1;
+  // Faces before any usemtl (or with no MTL at all): white Lambertian, so that a
+  // texture paired with the mesh shows as it is.
+  auto make_default = [] {
+    MeshMaterial d;
+    d.name = "default";
+    d.material = make_material(MaterialKind::Lambertian, vec3(1.0f), 0.0f, 1.0f, vec3(0.0f));
+    return d;
+  };
+
+  const size_t nv = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3, nt = attrib.texcoords.size() / 2;
+  auto position = [&](int i) { return glm::make_vec3(&attrib.vertices[3 * static_cast<size_t>(i)]); };
+  MeshBuilder builder(mesh);
+  std::unordered_map<std::array<int, 3>, uint32_t, CornerHash> vertices;
+  for (const tinyobj::shape_t& shape : shapes) {
+    const auto& idx = shape.mesh.indices;
+    for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+      // Triangulated: every face has three corners.
+      const tinyobj::index_t* c = &idx[3 * f];
+      for (int k = 0; k < 3; ++k) {
+        if (c[k].vertex_index < 0 || static_cast<size_t>(c[k].vertex_index) >= nv ||
+            c[k].normal_index >= static_cast<int>(nn) || c[k].texcoord_index >= static_cast<int>(nt)) {
+          fail(path, "face " + std::to_string(f) + " of '" + shape.name + "': index out of range");
+        }
+      }
+      if (!builder.keep(position(c[0].vertex_index), position(c[1].vertex_index), position(c[2].vertex_index))) {
+        continue;
+      }
+      uint32_t corner[3];
+      for (int k = 0; k < 3; ++k) {
+        std::array<int, 3> key = {c[k].vertex_index, c[k].normal_index, c[k].texcoord_index};
+        auto [it, added] = vertices.emplace(key, 0);
+        if (added) {
+          vec3 n = key[1] >= 0 ? glm::make_vec3(&attrib.normals[3 * static_cast<size_t>(key[1])]) : vec3(0.0f);
+          vec2 uv = key[2] >= 0 ? glm::make_vec2(&attrib.texcoords[2 * static_cast<size_t>(key[2])]) : vec2(0.0f);
+          it->second = builder.add_vertex(position(key[0]), key[1] >= 0 ? &n : nullptr, key[2] >= 0 ? &uv : nullptr);
+        }
+        corner[k] = it->second;
+      }
+      int id = shape.mesh.material_ids[f];
+      uint32_t material = id >= 0 ? static_cast<uint32_t>(id) : default_material(mesh, fallback, make_default);
+      builder.add_triangle(corner[0], corner[1], corner[2], material);
+    }
+  }
+  builder.finish();
+}
+
+// ---- glTF 2.0 ----
+
+// An accessor's elements, bounds-checked against its buffer view and buffer.
+struct Elements {
+  const unsigned char* data = nullptr;
+  size_t stride = 0, count = 0;
+  int component = 0;
+  bool normalized = false;
+};
+
+Elements elements(const tinygltf::Model& model, int index, const std::string& what, int type,
+                  const std::vector<int>& components, const std::string& path) {
+  if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) {
+    fail(path, what + ": accessor index " + std::to_string(index) + " out of range");
+  }
+  const tinygltf::Accessor& a = model.accessors[index];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (a.sparse.isSparse) fail(path, where + ": sparse accessors are not supported");
+  if (a.type != type) fail(path, where + ": wrong element type");
+  if (std::find(components.begin(), components.end(), a.componentType) == components.end()) {
+    fail(path, where + ": unsupported component type " + std::to_string(a.componentType));
+  }
+  if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= model.bufferViews.size()) {
+    fail(path, where + ": buffer view index out of range");
+  }
+  const tinygltf::BufferView& view = model.bufferViews[a.bufferView];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) {
+    fail(path, where + ": buffer index out of range");
+  }
+  const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
+  const size_t elem = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(a.componentType)) *
+                      static_cast<size_t>(tinygltf::GetNumComponentsInType(a.type));
+  Elements e;
+  e.stride = view.byteStride ? view.byteStride : elem;
+  e.count = a.count;
+  e.component = a.componentType;
+  e.normalized = a.normalized;
+  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset) {
+    fail(path, where + ": buffer view runs past the end of its buffer");
+  }
+  if (e.stride < elem) fail(path, where + ": byte stride smaller than an element");
+  if (e.count > 0 && (a.byteOffset > view.byteLength || elem > view.byteLength - a.byteOffset ||
+                      (e.count - 1) > (view.byteLength - a.byteOffset - elem) / e.stride)) {
+    fail(path, where + ": elements run past the end of the buffer view");
+  }
+  e.data = buffer.data() + view.byteOffset + a.byteOffset;
+  return e;
+}
+
+float component(const Elements& e, size_t i, int c) {
+  const unsigned char* p = e.data + i * e.stride;
+  switch (e.component) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return e.normalized ? p[c] / 255.0f : p[c];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p + 2 * c, 2);
+      return e.normalized ? v / 65535.0f : v;
+    }
+    default: {
+      float v;
+      std::memcpy(&v, p + 4 * c, 4);
+      return v;
+    }
+  }
+}
+
+uint32_t index_at(const Elements& e, size_t i) {
+  const unsigned char* p = e.data + i * e.stride;
+  switch (e.component) {
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
+MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g, size_t index, const fs::path& dir,
+                      const std::string& path) {
+  MeshMaterial out;
+  out.name = g.name.empty() ? "material " + std::to_string(index) : g.name;
+  const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+  if (pbr.baseColorFactor.size() != 4) fail(path, "material '" + out.name + "': baseColorFactor must be 4 numbers");
+  if (g.emissiveFactor.size() != 3) fail(path, "material '" + out.name + "': emissiveFactor must be 3 numbers");
+  vec3 base = checked_colour(path, out.name, "baseColorFactor", pbr.baseColorFactor.data(), false);
+  vec3 emissive = checked_colour(path, out.name, "emissiveFactor", g.emissiveFactor.data(), true);
+  auto unit = [&](double v, const char* field) {
+    if (!(v >= 0.0 && v <= 1.0)) fail(path, "material '" + out.name + "': " + field + " must be in [0, 1]");
+    return static_cast<float>(v);
+  };
+  float metallic = unit(pbr.metallicFactor, "metallicFactor");
+  float roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > 0.0f) {
+    out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, emissive);
+  } else if (metallic >= 0.5f) {
+    out.material = make_material(MaterialKind::Metal, base, roughness, 1.0f, vec3(0.0f));
+  } else if (roughness < 0.5f) {
+    // glTF's dielectric reflectance (F0 = 0.04) is that of ior 1.5.
+    out.material = make_material(MaterialKind::Coated, base, 0.0f, 1.5f, vec3(0.0f));
+  } else {
+    out.material = make_material(MaterialKind::Lambertian, base, 0.0f, 1.0f, vec3(0.0f));
+  }
+  int texture = pbr.baseColorTexture.index;
+  if (texture >= 0 && textured(out.material.kind)) {
+    const std::string where = "material '" + out.name + "': base colour texture";
+    if (static_cast<size_t>(texture) >= model.textures.size()) fail(path, where + " index out of range");
+    int source = model.textures[texture].source;
+    if (source < 0 || static_cast<size_t>(source) >= model.images.size()) {
+      fail(path, where + ": image index out of range");
+    }
+    const tinygltf::Image& image = model.images[source];
+    if (image.uri.empty()) fail(path, where + " is embedded in the file (only image files are supported)");
+    out.albedo_map = (dir / image.uri).lexically_normal().string();
+  }
+  return out;
+}
+
+// A node's transform relative to its parent.
+glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& path) {
+  if (!node.matrix.empty()) {
+    if (node.matrix.size() != 16) fail(path, "node '" + node.name + "': matrix must be 16 numbers");
+    return glm::make_mat4(node.matrix.data());
+  }
+  glm::dmat4 m(1.0);
+  if (!node.translation.empty()) {
+    if (node.translation.size() != 3) fail(path, "node '" + node.name + "': translation must be 3 numbers");
+    m = glm::translate(m, glm::make_vec3(node.translation.data()));
+  }
+  if (!node.rotation.empty()) {
+    if (node.rotation.size() != 4) fail(path, "node '" + node.name + "': rotation must be 4 numbers");
+    const std::vector<double>& q = node.rotation;  // x, y, z, w
+    m = m * glm::mat4_cast(glm::dquat(q[3], q[0], q[1], q[2]));
+  }
+  if (!node.scale.empty()) {
+    if (node.scale.size() != 3) fail(path, "node '" + node.name + "': scale must be 3 numbers");
+    m = glm::scale(m, glm::make_vec3(node.scale.data()));
+  }
+  return m;
+}
+
+class GltfReader {
+ public:
+  GltfReader(const tinygltf::Model& model, const fs::path& dir, TriangleMesh& mesh)
+      : model_(model), mesh_(mesh), builder_(mesh) {
+    for (size_t i = 0; i < model.materials.size(); ++i) {
+      mesh.materials.push_back(map_gltf(model, model.materials[i], i, dir, mesh.source));
+    }
+  }
+
+  void read() {
+    const std::vector<tinygltf::Scene>& scenes = model_.scenes;
+    if (scenes.empty()) {
+      for (size_t m = 0; m < model_.meshes.size(); ++m) read_mesh(static_cast<int>(m), glm::dmat4(1.0));
+    } else {
+      int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+      if (static_cast<size_t>(s) >= scenes.size()) fail(mesh_.source, "default scene index out of range");
+      for (int node : scenes[s].nodes) visit(node, glm::dmat4(1.0), 0);
+    }
+    builder_.finish();
+  }
+
+ private:
+  void visit(int index, const glm::dmat4& parent, size_t depth) {
+    if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size()) {
+      fail(mesh_.source, "node index " + std::to_string(index) + " out of range");
+    }
+    if (depth > model_.nodes.size()) fail(mesh_.source, "the node hierarchy has a cycle");
+    const tinygltf::Node& node = model_.nodes[index];
+    glm::dmat4 world = parent * local_transform(node, mesh_.source);
+    if (node.mesh >= 0) read_mesh(node.mesh, world);
+    for (int child : node.children) visit(child, world, depth + 1);
+  }
+
+  void read_mesh(int index, const glm::dmat4& world) {
+    const std::string& path = mesh_.source;
+    if (static_cast<size_t>(index) >= model_.meshes.size()) fail(path, "mesh index out of range");
+    const tinygltf::Mesh& m = model_.meshes[index];
+    const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+    for (size_t p = 0; p < m.primitives.size(); ++p) {
+      const tinygltf::Primitive& prim = m.primitives[p];
+      const std::string what = "mesh " + std::to_string(index) + " primitive " + std::to_string(p);
+      if (prim.mode != -1 && prim.mode != TINYGLTF_MODE_TRIANGLES) {
+        fail(path, what + ": mode " + std::to_string(prim.mode) + " is not supported (only triangles)");
+      }
+      auto attribute = [&](const char* name) {
+        auto it = prim.attributes.find(name);
+        return it == prim.attributes.end() ? -1 : it->second;
+      };
+      const int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
+      if (attribute("POSITION") < 0) fail(path, what + ": no POSITION attribute");
+      Elements pos = elements(model_, attribute("POSITION"), what + " POSITION", TINYGLTF_TYPE_VEC3, {kFloat}, path);
+      Elements nrm, uv;
+      if (attribute("NORMAL") >= 0) {
+        nrm = elements(model_, attribute("NORMAL"), what + " NORMAL", TINYGLTF_TYPE_VEC3, {kFloat}, path);
+        if (nrm.count != pos.count) fail(path, what + ": NORMAL and POSITION counts differ");
+      }
+      if (attribute("TEXCOORD_0") >= 0) {
+        uv = elements(model_, attribute("TEXCOORD_0"), what + " TEXCOORD_0", TINYGLTF_TYPE_VEC2,
+                      {kFloat, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, path);
+        if (uv.count != pos.count) fail(path, what + ": TEXCOORD_0 and POSITION counts differ");
+      }
+      uint32_t material;
+      if (prim.material >= 0) {
+        if (static_cast<size_t>(prim.material) >= model_.materials.size()) fail(path, what + ": material index out of range");
+        material = static_cast<uint32_t>(prim.material);
+      } else {
+        material = default_material(mesh_, default_, [&] {
+          tinygltf::Material g;  // glTF's default material
+          g.name = "default";
+          return map_gltf(model_, g, 0, fs::path(), path);
+        });
+      }
+
+      const size_t first = mesh_.positions.size();
+      std::vector<vec3> world_pos(pos.count);
+      for (size_t i = 0; i < pos.count; ++i) {
+        glm::dvec4 p4 = world * glm::dvec4(component(pos, i, 0), component(pos, i, 1), component(pos, i, 2), 1.0);
+        world_pos[i] = vec3(p4);
+        vec3 n;
+        if (nrm.data) n = vec3(normal_matrix * glm::dvec3(component(nrm, i, 0), component(nrm, i, 1), component(nrm, i, 2)));
+        // glTF puts v = 0 at the image's top, OBJ (and TriangleMesh) at its bottom.
+        vec2 tc = uv.data ? vec2(component(uv, i, 0), 1.0f - component(uv, i, 1)) : vec2(0.0f);
+        builder_.add_vertex(world_pos[i], nrm.data ? &n : nullptr, uv.data ? &tc : nullptr);
+      }
+
+      Elements idx;
+      size_t corners = pos.count;
+      if (prim.indices >= 0) {
+        idx = elements(model_, prim.indices, what + " indices", TINYGLTF_TYPE_SCALAR,
+                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+                       path);
+        corners = idx.count;
+      }
+      if (corners % 3 != 0) fail(path, what + ": " + std::to_string(corners) + " corners is not a multiple of 3");
+      for (size_t t = 0; t < corners / 3; ++t) {
+        uint32_t c[3];
+        for (int k = 0; k < 3; ++k) {
+          c[k] = idx.data ? index_at(idx, 3 * t + k) : static_cast<uint32_t>(3 * t + k);
+          if (c[k] >= pos.count) {
+            fail(path, what + ": index " + std::to_string(c[k]) + " out of range (" + std::to_string(pos.count) +
+                           " vertices)");
+          }
+        }
+        if (!builder_.keep(world_pos[c[0]], world_pos[c[1]], world_pos[c[2]])) continue;
+        builder_.add_triangle(static_cast<uint32_t>(first + c[0]), static_cast<uint32_t>(first + c[1]),
+                              static_cast<uint32_t>(first + c[2]), material);
+      }
+    }
+  }
+
+  const tinygltf::Model& model_;
+  TriangleMesh& mesh_;
+  MeshBuilder builder_;
+  int64_t default_ = -1;
+};
+
+// Images are not decoded here: only their file names are kept.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+void load_gltf(const std::string& bytes, bool binary, const fs::path& dir, TriangleMesh& mesh) {
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) fail(mesh.source, "file too large for tinygltf");
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skip_image, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  const unsigned int size = static_cast<unsigned int>(bytes.size());
+  bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                                 reinterpret_cast<const unsigned char*>(bytes.data()), size,
+                                                 dir.string())
+                   : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, dir.string());
+  if (!ok || !err.empty()) fail(mesh.source, "malformed glTF: " + first_line(err.empty() ? warn : err));
+  GltfReader(model, dir, mesh).read();
+}
+
+}  // namespace
+
+TriangleMesh load_mesh(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
+    fail(path, "unknown mesh format '" + ext + "' (expected .obj, .gltf, .glb)");
+  }
+  const std::string bytes = read_file(path, "mesh file");
+  const fs::path dir = fs::path(path).parent_path();
+  TriangleMesh mesh;
+  mesh.source = path;
+  if (ext == ".obj") {
+    load_obj(bytes, dir, mesh);
+  } else {
+    load_gltf(bytes, ext == ".glb", dir, mesh);
+  }
+  return mesh;
+}
+
+}  // namespace wt

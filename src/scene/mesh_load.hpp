@@ -1,0 +1,41 @@
+// Triangle meshes from Wavefront OBJ (+ MTL, through tinyobjloader) and glTF 2.0
+// (.gltf, .glb, through tinygltf), read into host arrays with their materials mapped
+// onto wavetrace's (docs/scene-format.md, "Meshes"). Scene files cannot place meshes
+// yet: this is the loading half of issue 7.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "wavetrace/material.hpp"
+
+namespace wt {
+
+// One of the file's materials, mapped onto a wavetrace Material.
+struct MeshMaterial {
+  std::string name;        // as the file names it ("default" for faces without one)
+  Material material{};     // texture < 0; sort_key set as for an untextured material
+  std::string albedo_map;  // the albedo texture's file, resolved against the mesh file's folder; "" for none
+};
+
+struct TriangleMesh {
+  std::string source;  // the mesh file
+  std::vector<vec3> positions;
+  std::vector<vec3> normals;  // shading normals, one per vertex; empty where the file lacks any
+  std::vector<vec2> uvs;      // one per vertex; empty where the file lacks any
+  std::vector<std::array<uint32_t, 3>> triangles;  // vertex indices
+  std::vector<uint32_t> triangle_material;         // per triangle, an index into materials
+  std::vector<MeshMaterial> materials;
+  size_t dropped_degenerate = 0;  // zero-area triangles (and faces of fewer than 3 corners)
+  size_t dropped_nan = 0;         // triangles with a non-finite position
+};
+
+// Reads a mesh file, its format chosen by extension (.obj, .gltf, .glb; any case).
+// A glTF file's default scene (or its first; or, with none, every mesh) is read with
+// its node transforms applied. Throws SceneError "<path>: <what is wrong>".
+TriangleMesh load_mesh(const std::string& path);
+
+}  // namespace wt

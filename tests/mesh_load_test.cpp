@@ -1,0 +1,427 @@
+// Mesh loading (src/scene/mesh_load.cpp): small OBJ, glTF and GLB files written
+// here with known contents, each error, dropped triangles, and the real models of
+// ../shared/models where that folder is present.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "scene/mesh_load.hpp"
+#include "scene/scene.hpp"
+#include "test_support.hpp"
+
+// tinygltf's own encoder (compiled in src/scene/mesh_libraries.cpp), for embedded buffers.
+namespace tinygltf {
+std::string base64_encode(unsigned char const* bytes, unsigned int len);
+}
+
+namespace wt {
+namespace {
+
+class MeshLoad : public ::testing::Test {
+ protected:
+  std::string write(const std::string& name, const std::string& text) {
+    std::string path = (folder_.root() / name).string();
+    std::ofstream(path, std::ios::binary) << text;
+    return path;
+  }
+
+  // load_mesh must throw a SceneError that starts with the file and contains `what`.
+  void expect_error(const std::string& path, const std::string& what) {
+    try {
+      load_mesh(path);
+      ADD_FAILURE() << path << " loaded; expected: " << what;
+    } catch (const SceneError& e) {
+      std::string message = e.what();
+      EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+      EXPECT_NE(message.find(what), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+
+  test::TestFolder folder_;
+};
+
+void expect_vec(const vec3& got, const vec3& want) {
+  EXPECT_FLOAT_EQ(got.x, want.x);
+  EXPECT_FLOAT_EQ(got.y, want.y);
+  EXPECT_FLOAT_EQ(got.z, want.z);
+}
+
+constexpr const char* kMtl = R"(newmtl matte
+Kd 0.5 0.25 0.125
+map_Kd tex/wood.png
+newmtl steel
+Kd 0 0 0
+Ks 0.9 0.8 0.7
+Ns 48
+newmtl lacquer
+Kd 0.2 0.3 0.4
+Ks 0.5 0.5 0.5
+Ni 1.4
+newmtl glass
+Kd 0 0 0
+d 0.25
+Ni 1.33
+newmtl lamp
+Kd 0.5 0.5 0.5
+Ke 4 3 2
+)";
+
+// A unit quad (two triangles through the library's triangulation) with normals and
+// UVs, and one triangle per further material.
+constexpr const char* kObj = R"(mtllib quad.mtl
+v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vn 0 0 2
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+usemtl matte
+f 1/1/1 2/2/1 3/3/1 4/4/1
+usemtl steel
+f 1/1/1 2/2/1 3/3/1
+usemtl lacquer
+f 1/1/1 3/3/1 4/4/1
+usemtl glass
+f 1/1/1 2/2/1 4/4/1
+usemtl lamp
+f 2/2/1 3/3/1 4/4/1
+)";
+
+TEST_F(MeshLoad, ObjGivesPositionsNormalsUvsTrianglesAndMaterials) {
+  write("quad.mtl", kMtl);
+  const std::string path = write("quad.obj", kObj);
+  TriangleMesh m = load_mesh(path);
+  EXPECT_EQ(m.source, path);
+  // One vertex per distinct (position, normal, uv) corner: the four of the quad, in
+  // the order the library's triangulation reaches them. Here uv = position's (x, y).
+  ASSERT_EQ(m.positions.size(), 4u);
+  ASSERT_EQ(m.normals.size(), 4u);
+  ASSERT_EQ(m.uvs.size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    expect_vec(m.normals[i], vec3(0, 0, 1));  // normalized
+    EXPECT_EQ(m.positions[i].z, 0.0f);
+    EXPECT_EQ(m.uvs[i].x, m.positions[i].x);
+    EXPECT_EQ(m.uvs[i].y, m.positions[i].y);
+  }
+  ASSERT_EQ(m.triangles.size(), 6u);
+  auto corners = [&](size_t t) {
+    std::vector<vec3> c;
+    for (uint32_t v : m.triangles[t]) c.push_back(m.positions[v]);
+    return c;
+  };
+  // The quad's split is the library's: two triangles of area 1/2 each, together over the four corners.
+  std::vector<int> seen(4, 0);
+  for (size_t t = 0; t < 2; ++t) {
+    std::vector<vec3> c = corners(t);
+    EXPECT_FLOAT_EQ(glm::length(glm::cross(c[1] - c[0], c[2] - c[0])), 1.0f);
+    for (uint32_t v : m.triangles[t]) ++seen[v];
+  }
+  for (int count : seen) EXPECT_GE(count, 1);
+  const vec3 p1(0, 0, 0), p2(1, 0, 0), p3(1, 1, 0), p4(0, 1, 0);
+  EXPECT_EQ(corners(2), (std::vector<vec3>{p1, p2, p3}));
+  EXPECT_EQ(corners(3), (std::vector<vec3>{p1, p3, p4}));
+  EXPECT_EQ(corners(4), (std::vector<vec3>{p1, p2, p4}));
+  EXPECT_EQ(corners(5), (std::vector<vec3>{p2, p3, p4}));
+  EXPECT_EQ(m.triangle_material, (std::vector<uint32_t>{0, 0, 1, 2, 3, 4}));
+  EXPECT_EQ(m.dropped_degenerate, 0u);
+  EXPECT_EQ(m.dropped_nan, 0u);
+
+  ASSERT_EQ(m.materials.size(), 5u);
+  const MeshMaterial& matte = m.materials[0];
+  EXPECT_EQ(matte.name, "matte");
+  EXPECT_EQ(matte.material.kind, MaterialKind::Lambertian);
+  expect_vec(matte.material.albedo, vec3(0.5f, 0.25f, 0.125f));
+  EXPECT_EQ(matte.albedo_map, (folder_.root() / "tex/wood.png").string());
+  EXPECT_EQ(matte.material.texture, -1);
+
+  const Material& steel = m.materials[1].material;
+  EXPECT_EQ(steel.kind, MaterialKind::Metal);
+  expect_vec(steel.albedo, vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_FLOAT_EQ(steel.fuzz, 0.2f);  // sqrt(2 / (48 + 2))
+
+  const Material& lacquer = m.materials[2].material;
+  EXPECT_EQ(lacquer.kind, MaterialKind::Coated);
+  expect_vec(lacquer.albedo, vec3(0.2f, 0.3f, 0.4f));
+  EXPECT_FLOAT_EQ(lacquer.ior, 1.4f);
+
+  const Material& glass = m.materials[3].material;
+  EXPECT_EQ(glass.kind, MaterialKind::Dielectric);
+  EXPECT_FLOAT_EQ(glass.ior, 1.33f);
+  expect_vec(glass.albedo, vec3(1.0f));
+
+  const Material& lamp = m.materials[4].material;
+  EXPECT_EQ(lamp.kind, MaterialKind::Emissive);
+  expect_vec(lamp.emission, vec3(4, 3, 2));
+  for (const MeshMaterial& mm : m.materials) {
+    EXPECT_EQ(mm.material.sort_key, material_sort_key(mm.material.kind, -1)) << mm.name;
+  }
+}
+
+TEST_F(MeshLoad, ObjWithoutMaterialsNormalsOrUvsGetsTheDefaultMaterial) {
+  const std::string path = write("plain.obj", "v 0 0 0\nv 2 0 0\nv 0 3 0\nf 1 2 3\n");
+  TriangleMesh m = load_mesh(path);
+  EXPECT_TRUE(m.normals.empty());
+  EXPECT_TRUE(m.uvs.empty());
+  ASSERT_EQ(m.triangles.size(), 1u);
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].name, "default");
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Lambertian);
+  expect_vec(m.materials[0].material.albedo, vec3(1.0f));
+  EXPECT_EQ(m.triangle_material, std::vector<uint32_t>{0});
+}
+
+TEST_F(MeshLoad, ObjDropsAndCountsDegenerateTriangles) {
+  // A good triangle, one with a repeated corner, one of collinear corners, a
+  // two-corner face.
+  const std::string path = write("degenerate.obj",
+                                 "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n"
+                                 "f 1 2 3\nf 1 2 2\nf 1 2 4\nf 1 2\n");
+  TriangleMesh m = load_mesh(path);
+  ASSERT_EQ(m.triangles.size(), 1u);
+  EXPECT_EQ(m.dropped_degenerate, 3u);
+  EXPECT_EQ(m.dropped_nan, 0u);
+}
+
+TEST_F(MeshLoad, ObjErrorsNameTheFileAndTheProblem) {
+  expect_error((folder_.root() / "missing.obj").string(), "cannot open mesh file (No such file or directory)");
+  expect_error(write("mesh.ply", "ply\n"), "unknown mesh format '.ply' (expected .obj, .gltf, .glb)");
+  expect_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "malformed OBJ: ");
+  expect_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of");
+  expect_error(write("empty.obj", "# nothing\nv 0 0 0\n"), "has no triangles");
+  expect_error(write("flat.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\n"), "no triangles left (1 degenerate and 0 non-finite dropped)");
+  expect_error(write("nomtl.obj", "mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "malformed OBJ: Material file [ absent.mtl ] not found");
+  write("one.mtl", "newmtl known\nKd 1 1 1\n");
+  expect_error(write("unknown.obj", "mtllib one.mtl\nusemtl nosuch\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "malformed OBJ: material [ 'nosuch' ] not found in .mtl");
+  write("bright.mtl", "newmtl bright\nKd 1.5 1 1\n");
+  expect_error(write("bright.obj", "mtllib bright.mtl\nusemtl bright\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "material 'bright': Kd must be 3 numbers in [0, 1]");
+}
+
+// ---- glTF ----
+
+// The binary buffer of a test glTF: positions, normals and UVs of `n` vertices, then
+// the indices as unsigned shorts.
+struct Buffer {
+  std::string bytes;
+  template <typename T>
+  size_t add(const std::vector<T>& values) {
+    size_t offset = bytes.size();
+    bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    while (bytes.size() % 4) bytes.push_back('\0');
+    return offset;
+  }
+};
+
+// A glTF document over `buffer` (given as `buffer_json`): vertices with normals and
+// UVs, an unsigned-short index list, a node translated by (10, 20, 30), one
+// material. `indices` counts the indices.
+std::string gltf_json(const std::string& buffer_json, size_t buffer_size, size_t vertices, size_t indices,
+                      const std::string& material) {
+  const size_t p = 0, n = vertices * 12, t = vertices * 24, i = vertices * 32;
+  auto view = [](size_t offset, size_t length) {
+    return "{\"buffer\": 0, \"byteOffset\": " + std::to_string(offset) + ", \"byteLength\": " +
+           std::to_string(length) + "}";
+  };
+  auto accessor = [](int view_index, size_t count, int component, const char* type) {
+    return "{\"bufferView\": " + std::to_string(view_index) + ", \"componentType\": " + std::to_string(component) +
+           ", \"count\": " + std::to_string(count) + ", \"type\": \"" + type + "\"}";
+  };
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0, "translation": [10, 20, 30]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
+  "materials": [)" + material + R"(],
+  "buffers": [)" + buffer_json + R"(],
+  "bufferViews": [)" + view(p, n - p) + ", " + view(n, t - n) + ", " + view(t, i - t) + ", " +
+         view(i, buffer_size - i) + R"(],
+  "accessors": [)" + accessor(0, vertices, 5126, "VEC3") + ", " + accessor(1, vertices, 5126, "VEC3") + ", " +
+         accessor(2, vertices, 5126, "VEC2") + ", " + accessor(3, indices, 5123, "SCALAR") + "]}";
+}
+
+struct TestGltf {
+  std::vector<float> positions, normals, uvs;
+  std::vector<uint16_t> indices;
+  std::string material = R"({"name": "brass", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 0.5],
+    "metallicFactor": 1, "roughnessFactor": 0.25}})";
+  Buffer buffer() const {
+    Buffer b;
+    b.add(positions);
+    b.add(normals);
+    b.add(uvs);
+    b.add(indices);
+    return b;
+  }
+  std::string embedded() const {
+    Buffer b = buffer();
+    std::string uri = "data:application/octet-stream;base64," +
+                      tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(b.bytes.data()),
+                                              static_cast<unsigned>(b.bytes.size()));
+    std::string buffer_json = "{\"byteLength\": " + std::to_string(b.bytes.size()) + ", \"uri\": \"" + uri + "\"}";
+    return gltf_json(buffer_json, b.bytes.size(), positions.size() / 3, indices.size(), material);
+  }
+  // The GLB container: a 12-byte header, the JSON chunk (padded with spaces), the BIN chunk.
+  std::string binary() const {
+    Buffer b = buffer();
+    std::string json = gltf_json("{\"byteLength\": " + std::to_string(b.bytes.size()) + "}", b.bytes.size(),
+                                 positions.size() / 3, indices.size(), material);
+    while (json.size() % 4) json.push_back(' ');
+    auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    std::string out = "glTF" + u32(2) + u32(static_cast<uint32_t>(12 + 8 + json.size() + 8 + b.bytes.size()));
+    out += u32(static_cast<uint32_t>(json.size())) + "JSON" + json;
+    out += u32(static_cast<uint32_t>(b.bytes.size())) + "BIN" + std::string(1, '\0') + b.bytes;
+    return out;
+  }
+};
+
+// A unit quad in z = 0 as two indexed triangles, normals along +z (given scaled).
+TestGltf quad() {
+  TestGltf g;
+  g.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+  g.normals = {0, 0, 3, 0, 0, 3, 0, 0, 3, 0, 0, 3};
+  g.uvs = {0, 0, 1, 0, 1, 1, 0, 0.25f};
+  g.indices = {0, 1, 2, 0, 2, 3};
+  return g;
+}
+
+void expect_quad(const TriangleMesh& m) {
+  ASSERT_EQ(m.positions.size(), 4u);
+  ASSERT_EQ(m.normals.size(), 4u);
+  ASSERT_EQ(m.uvs.size(), 4u);
+  const vec3 corners[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  const float v[4] = {1, 1, 0, 0.75f};  // glTF's v flipped: 1 - v
+  for (size_t i = 0; i < 4; ++i) {
+    expect_vec(m.positions[i], corners[i] + vec3(10, 20, 30));  // the node's translation
+    expect_vec(m.normals[i], vec3(0, 0, 1));
+    EXPECT_FLOAT_EQ(m.uvs[i].x, corners[i].x);
+    EXPECT_FLOAT_EQ(m.uvs[i].y, v[i]);
+  }
+  ASSERT_EQ(m.triangles.size(), 2u);
+  EXPECT_EQ(m.triangles[0], (std::array<uint32_t, 3>{0, 1, 2}));
+  EXPECT_EQ(m.triangles[1], (std::array<uint32_t, 3>{0, 2, 3}));
+  EXPECT_EQ(m.triangle_material, (std::vector<uint32_t>{0, 0}));
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].name, "brass");
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Metal);
+  expect_vec(m.materials[0].material.albedo, vec3(0.5f, 0.25f, 1.0f));
+  EXPECT_FLOAT_EQ(m.materials[0].material.fuzz, 0.25f);
+}
+
+TEST_F(MeshLoad, GltfWithAnEmbeddedBuffer) { expect_quad(load_mesh(write("quad.gltf", quad().embedded()))); }
+
+TEST_F(MeshLoad, Glb) { expect_quad(load_mesh(write("quad.glb", quad().binary()))); }
+
+TEST_F(MeshLoad, GltfMaterialsMapOntoTheNearestKind) {
+  struct Case {
+    std::string material;
+    MaterialKind kind;
+    vec3 albedo, emission;
+    float ior;
+  };
+  const Case cases[] = {
+      {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0, "roughnessFactor": 0.9}})",
+       MaterialKind::Lambertian, vec3(0.5f), vec3(0.0f), 1.0f},
+      {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1], "metallicFactor": 0.2, "roughnessFactor": 0.1}})",
+       MaterialKind::Coated, vec3(0.1f, 0.2f, 0.3f), vec3(0.0f), 1.5f},
+      {R"({"emissiveFactor": [1, 0.5, 0]})", MaterialKind::Emissive, vec3(0.0f), vec3(1.0f, 0.5f, 0.0f), 1.0f},
+      // glTF's default: metallic 1, roughness 1.
+      {R"({})", MaterialKind::Metal, vec3(1.0f), vec3(0.0f), 1.0f},
+  };
+  for (const Case& c : cases) {
+    TestGltf g = quad();
+    g.material = c.material;
+    TriangleMesh m = load_mesh(write("material.gltf", g.embedded()));
+    ASSERT_EQ(m.materials.size(), 1u) << c.material;
+    const Material& got = m.materials[0].material;
+    EXPECT_EQ(m.materials[0].name, "material 0");
+    EXPECT_EQ(got.kind, c.kind) << c.material;
+    expect_vec(got.albedo, c.albedo);
+    expect_vec(got.emission, c.emission);
+    EXPECT_FLOAT_EQ(got.ior, c.ior);
+  }
+}
+
+TEST_F(MeshLoad, GltfBaseColourTextureIsAFileBesideTheMesh) {
+  TestGltf g = quad();
+  g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"uri": "maps/base.png"}], "samplers": [{})";
+  TriangleMesh m = load_mesh(write("textured.gltf", g.embedded()));
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Lambertian);
+  EXPECT_EQ(m.materials[0].albedo_map, (folder_.root() / "maps/base.png").string());
+}
+
+TEST_F(MeshLoad, GltfDropsAndCountsNanAndDegenerateTriangles) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  TestGltf g = quad();
+  g.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, nan, 0, 0, 2, 0, 0};
+  g.normals.assign(15, 0.0f);
+  for (size_t i = 2; i < 15; i += 3) g.normals[i] = 1.0f;
+  g.uvs.assign(10, 0.0f);
+  g.indices = {0, 1, 2, 0, 1, 3, 0, 1, 4, 2, 2, 1};  // good, NaN, collinear, repeated
+  TriangleMesh m = load_mesh(write("dropped.gltf", g.embedded()));
+  ASSERT_EQ(m.triangles.size(), 1u);
+  EXPECT_EQ(m.triangles[0], (std::array<uint32_t, 3>{0, 1, 2}));
+  EXPECT_EQ(m.dropped_nan, 1u);
+  EXPECT_EQ(m.dropped_degenerate, 2u);
+}
+
+TEST_F(MeshLoad, GltfErrorsNameTheFileAndTheProblem) {
+  expect_error(write("bad.gltf", "{\"asset\": "), "malformed glTF: ");
+  expect_error(write("bad.glb", "glTF...."), "malformed glTF: ");
+  TestGltf range = quad();
+  range.indices = {0, 1, 7, 0, 2, 3};
+  expect_error(write("range.gltf", range.embedded()), "mesh 0 primitive 0: index 7 out of range (4 vertices)");
+  TestGltf odd = quad();
+  odd.indices = {0, 1, 2, 3};
+  expect_error(write("odd.gltf", odd.embedded()), "mesh 0 primitive 0: 4 corners is not a multiple of 3");
+  TestGltf flat = quad();
+  flat.indices = {0, 0, 1};
+  expect_error(write("flat.gltf", flat.embedded()), "no triangles left (1 degenerate and 0 non-finite dropped)");
+  // An accessor that claims more vertices than its buffer view holds.
+  std::string overrun = quad().embedded();
+  std::string from = "\"count\": 4, \"type\": \"VEC3\"";
+  overrun.replace(overrun.find(from), from.size(), "\"count\": 5, \"type\": \"VEC3\"");
+  expect_error(write("overrun.gltf", overrun), "POSITION (accessor 0): elements run past the end of the buffer view");
+  TestGltf embedded_image = quad();
+  embedded_image.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/png"}], "samplers": [{})";
+  expect_error(write("image.gltf", embedded_image.embedded()),
+               "material 'material 0': base colour texture is embedded in the file (only image files are supported)");
+}
+
+// ---- The real models of ../shared/models ----
+
+std::filesystem::path models() { return std::filesystem::path(test::repo_root()) / ".." / "shared" / "models"; }
+
+void expect_model(const char* file, size_t triangles, bool uvs) {
+  std::filesystem::path path = models() / file;
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path.string() << " (the shared models are optional)";
+  TriangleMesh m = load_mesh(path.string());
+  EXPECT_EQ(m.triangles.size() + m.dropped_degenerate + m.dropped_nan, triangles) << file;
+  EXPECT_EQ(m.triangles.size(), triangles) << file << ": " << m.dropped_degenerate << " degenerate, " << m.dropped_nan
+                                           << " non-finite dropped";
+  EXPECT_EQ(!m.uvs.empty(), uvs) << file;
+  EXPECT_EQ(m.triangle_material.size(), m.triangles.size());
+  for (const auto& t : m.triangles) {
+    for (uint32_t v : t) ASSERT_LT(v, m.positions.size());
+  }
+}
+
+TEST(SharedModels, Teapot) { expect_model("teapot.obj", 6320, false); }
+TEST(SharedModels, Spot) { expect_model("spot.obj", 5856, true); }
+TEST(SharedModels, StanfordBunny) { expect_model("stanford-bunny.obj", 69451, false); }
+TEST(SharedModels, Nefertiti) { expect_model("nefertiti.obj", 99938, false); }
+
+}  // namespace
+}  // namespace wt
