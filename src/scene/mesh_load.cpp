@@ -186,7 +186,8 @@ MeshMaterial map_mtl(const tinyobj::material_t& t, const fs::path& dir, const st
 // (position, normal, uv) indices of an OBJ corner, the key of one mesh vertex.
 struct CornerHash {
   size_t operator()(const std::array<int, 3>& k) const {
-    return std::hash<int64_t>()((static_cast<int64_t>(k[0]) << 32) ^ (static_cast<int64_t>(k[1]) << 16) ^ k[2]);
+    auto u = [](int i) { return static_cast<uint64_t>(static_cast<uint32_t>(i)); };  // -1 (absent) included
+    return std::hash<uint64_t>()((u(k[0]) << 32) ^ (u(k[1]) << 16) ^ u(k[2]));
   }
 };
 
