@@ -78,8 +78,7 @@ void SceneReader::remember(Names& names, const std::string& n, size_t index, con
 
 namespace {
 
-// Validates the parsed document into a Scene and builds its BVH, timing each phase.
-// Validates `root` into a scene and builds its BVH. The document is no longer needed
+// Validates `root` into a scene and builds its BVH, timing each phase. The document is no longer needed
 // once read: a big one (a million spheres is ten million small allocations) is
 // freed on a thread of its own while the BVH is built.
 Scene prepare(json root, const std::string& source, double parse_seconds) {
