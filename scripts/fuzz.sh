@@ -3,7 +3,7 @@
 # in turn, then merges what found new coverage into its corpus, fuzz/corpus/<target>.
 # A crash, leak, hang or sanitizer report stops that target, leaves the input as
 # build-fuzz/artifacts/<target>/crash-* (or leak-*, timeout-*, oom-*) and fails.
-#   scripts/fuzz.sh [TARGET...]     (default: scene jobs image)
+#   scripts/fuzz.sh [TARGET...]     (default: scene jobs image mesh)
 #   FUZZ_SECONDS  time per target (default 600)
 #   FUZZ_RUNS     executions per target, stopping at whichever comes first (default: no limit)
 # Run it under `nice -n 19` on a shared machine.
@@ -12,7 +12,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${WAVETRACE_FUZZ_BUILD:-$root/build-fuzz}
 seconds=${FUZZ_SECONDS:-600}
 targets=("$@")
-((${#targets[@]})) || targets=(scene jobs image)
+((${#targets[@]})) || targets=(scene jobs image mesh)
 
 WAVETRACE_WITH_FUZZ=1 bash "$root/scripts/setup.sh"
 export ASAN_SYMBOLIZER_PATH=/usr/lib/llvm-19/bin/llvm-symbolizer
