@@ -177,6 +177,29 @@ TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
   for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-5f * std::max(1.0f, a[i])) << i;
 }
 
+TEST_F(CheckpointTest, ACheckpointHoldingEverySampleIsTheImage) {
+  Checkpoint c = sample_checkpoint();
+  c.samples = c.identity.params.spp;
+  write_checkpoint(path("done.ckpt"), c);
+  Job j = job(path("done.pfm"));
+  const RenderParams& p = c.identity.params;
+  j.width = p.width;
+  j.height = p.height;
+  j.spp = p.spp;
+  j.depth = p.depth;
+  j.roulette_depth = p.roulette_depth;
+  j.seed = p.seed;
+  j.resume = path("done.ckpt");
+  const JobOutcome o = run_job(j);
+  ASSERT_EQ(o.exit_code, 0) << o.message;
+  EXPECT_EQ(o.result.radiance, Radiance::MeanOfSamples);
+  EXPECT_EQ(o.result.paths, 0u);  // nothing left to trace
+  // The mean as every render takes it: the sums times 1 / samples.
+  const auto image = test::read_pfm(path("done.pfm"), p.width, p.height);
+  ASSERT_EQ(image.size(), c.film.size());
+  for (size_t i = 0; i < image.size(); ++i) EXPECT_EQ(image[i], c.film[i] * (1.0f / p.spp)) << i;
+}
+
 TEST_F(CheckpointTest, AnExistingCheckpointOfAnotherRenderIsNeverOverwritten) {
   write_checkpoint(path("c.ckpt"), sample_checkpoint());
   const std::string before = bytes_of(path("c.ckpt"));

@@ -69,6 +69,8 @@ TEST_P(EveryKernel, FurnaceIsOneEverywhereWithoutRoulette) {
   // A path that escapes at once adds 1; one that hits adds 1 * 1 after one bounce
   // (a convex sphere cannot be hit twice). Only float rounding separates pixels from 1.
   for (float v : r.rgb) ASSERT_NEAR(v, 1.0f, 1e-5f);
+  EXPECT_EQ(r.radiance, Radiance::MeanOfSamples);
+  EXPECT_EQ(r.samples, 4);
   EXPECT_EQ(r.paths, 24u * 16u * 4u);
   EXPECT_GE(r.rays, r.paths);
   EXPECT_LE(r.rays, 2 * r.paths);

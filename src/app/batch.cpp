@@ -12,6 +12,7 @@
 
 #include "app/cli.hpp"
 #include "app/process.hpp"
+#include "app/signals.hpp"
 
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -181,12 +182,6 @@ void read_measurements(const std::string& path, JobOutcome& o) {
   o.kernel = j.value("kernel", "");
   o.result.seconds = j.value("seconds", 0.0);
   o.result.rays = j.value("rays", uint64_t(0));
-}
-
-std::string signal_name(int sig) {
-  if (sig == SIGINT) return "SIGINT";
-  if (sig == SIGTERM) return "SIGTERM";
-  return "signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
 }
 
 // Runs one job as `wavetrace render` in a process of its own.

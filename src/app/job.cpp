@@ -179,8 +179,8 @@ JobOutcome run_job(const Job& job) {
     if (resumed.samples >= rp.spp && !resumed.film.empty()) {
       // Every sample was done before: the image is the checkpoint's film.
       out.result.rgb = resumed.film;
-      for (float& v : out.result.rgb) v /= static_cast<float>(rp.spp);
       out.result.samples = rp.spp;
+      take_mean(out.result);
     } else {
       ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
       if (job.progress) options.progress = progress.callback();
@@ -189,7 +189,7 @@ JobOutcome run_job(const Job& job) {
     if (out.result.interrupted) {
       const int sig = signals->caught();
       out.exit_code = 128 + sig;
-      out.message = std::string("interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM") + " at sample " +
+      out.message = "interrupted by " + signal_name(sig) + " at sample " +
                     std::to_string(out.result.samples) + " of " + std::to_string(rp.spp) +
                     "; checkpoint written to " + checkpoint_path + " (resume with --resume " + checkpoint_path + ")";
       return out;

@@ -2,6 +2,8 @@
 
 #include <pthread.h>
 
+#include <cstring>
+
 namespace wt::app {
 
 namespace {
@@ -36,5 +38,11 @@ SignalCatcher::~SignalCatcher() {
 }
 
 int SignalCatcher::caught() const { return g_caught; }
+
+std::string signal_name(int sig) {
+  if (sig == SIGINT) return "SIGINT";
+  if (sig == SIGTERM) return "SIGTERM";
+  return "signal " + std::to_string(sig) + " (" + strsignal(sig) + ")";
+}
 
 }  // namespace wt::app

@@ -6,8 +6,12 @@
 #pragma once
 
 #include <csignal>
+#include <string>
 
 namespace wt::app {
+
+// "SIGINT", "SIGTERM", or "signal N (its description)".
+std::string signal_name(int sig);
 
 class SignalCatcher {
  public:

@@ -34,11 +34,14 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                      std::to_string(film_floats));
   }
   RenderResult r = options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
-  // The backends return each pixel's sum over its samples: the mean is taken here, once.
+  take_mean(r);
+  return r;
+}
+
+void take_mean(RenderResult& r) {
   const float inv = 1.0f / static_cast<float>(r.samples);
   for (float& v : r.rgb) v *= inv;
   r.radiance = Radiance::MeanOfSamples;
-  return r;
 }
 
 }  // namespace wt

@@ -15,6 +15,10 @@ const char* backend_name(Backend b);
 // when the machine fails. The result holds each pixel's mean radiance.
 RenderResult render(const Scene& scene, const RenderOptions& options);
 
+// Turns a backend's pixel sums over r.samples samples into means (every render's
+// last step; also for a film that was complete when it was resumed).
+void take_mean(RenderResult& r);
+
 // Checks RenderParams against the sane limits; throws SceneError naming the setting.
 void validate_params(const RenderParams& p);
 
