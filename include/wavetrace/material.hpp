@@ -1,8 +1,8 @@
 // The materials: how a hit scatters the path and what it emits.
 #pragma once
 
+#include "wavetrace/geometry/surface.hpp"
 #include "wavetrace/optics.hpp"
-#include "wavetrace/ray.hpp"
 #include "wavetrace/sampling.hpp"
 #include "wavetrace/texture.hpp"
 
@@ -30,32 +30,16 @@ WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /
 constexpr uint32_t kSortKeyCount = kMaterialKindCount * 4;
 constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene sort last
 
-// Secondary rays leave the surface this far along the normal, on the side they go to.
-constexpr float kSurfaceOffset = 1e-3f;
-
-WT_HD WT_INLINE Ray spawn_ray(const vec3& p, const vec3& outward_n, const vec3& dir) {
-  float side = glm::dot(dir, outward_n) >= 0.0f ? 1.0f : -1.0f;
-  return Ray{p + (side * kSurfaceOffset) * outward_n, dir};
-}
-
-// Everything a material needs to know about the hit.
-struct SurfacePoint {
-  vec3 p;          // world position
-  vec3 n;          // unit outward normal
-  vec3 local;      // position relative to the sphere's centre
-  bool front;      // the ray arrived from outside
-};
-
 WT_HD WT_INLINE vec3 material_albedo(const Material& m, const Texture* textures, const ImageView* images,
                                      const SurfacePoint& sp) {
-  return m.texture < 0 ? m.albedo : m.albedo * eval_texture(textures[m.texture], images, sp.local, sp.n);
+  return m.texture < 0 ? m.albedo : m.albedo * eval_texture(textures[m.texture], images, sp);
 }
 
 WT_HD WT_INLINE void scatter_lambertian(const vec3& albedo, const SurfacePoint& sp, const vec3& facing_n,
                                         const Rng& rng, vec3& attenuation, Ray& next) {
   vec3 d = cosine_direction(facing_n, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB));
   attenuation = albedo;
-  next = spawn_ray(sp.p, sp.n, d);
+  next = spawn_ray(sp, d);
 }
 
 // Mirror reflection perturbed by fuzz; absorbed when the perturbation sends it
@@ -70,7 +54,7 @@ WT_HD WT_INLINE bool scatter_metal(const Material& m, const vec3& albedo, const 
     d *= 1.0f / sqrtf(len2);
   }
   attenuation = albedo;
-  next = spawn_ray(sp.p, sp.n, d);
+  next = spawn_ray(sp, d);
   return true;
 }
 
@@ -85,7 +69,7 @@ WT_HD WT_INLINE void scatter_dielectric(const Material& m, const vec3& albedo, c
     d = reflect(in.dir, facing_n);
   }
   attenuation = albedo;
-  next = spawn_ray(sp.p, sp.n, glm::normalize(d));
+  next = spawn_ray(sp, glm::normalize(d));
 }
 
 // A clear dielectric coat over a Lambertian base: the coat reflects with Schlick's
@@ -95,10 +79,16 @@ WT_HD WT_INLINE void scatter_coated(const Material& m, const vec3& albedo, const
   float cos_i = fminf(-glm::dot(in.dir, facing_n), 1.0f);
   if (sp.front && rng.uniform(kDimLayer) < schlick(cos_i, 1.0f / m.ior)) {
     attenuation = vec3(1.0f);
-    next = spawn_ray(sp.p, sp.n, reflect(in.dir, facing_n));
+    next = spawn_ray(sp, reflect(in.dir, facing_n));
     return;
   }
   scatter_lambertian(albedo, sp, facing_n, rng, attenuation, next);
+}
+
+// A reflection about a shading normal can point below the geometric surface,
+// where it would pass through the surface it leaves: the path ends there instead.
+WT_HD WT_INLINE bool above_surface(const SurfacePoint& sp, const Ray& next) {
+  return glm::dot(next.dir, sp.front ? sp.ng : -sp.ng) >= 0.0f;
 }
 
 // Scatters the path at a hit. Returns false when the path ends there (absorbed or emitter).
@@ -108,15 +98,16 @@ WT_HD WT_INLINE bool scatter(const Material& m, const Texture* textures, const I
   switch (m.kind) {
     case MaterialKind::Lambertian:
       scatter_lambertian(material_albedo(m, textures, images, sp), sp, facing_n, rng, attenuation, next);
-      return true;
+      return above_surface(sp, next);
     case MaterialKind::Metal:
-      return scatter_metal(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+      return scatter_metal(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next) &&
+             above_surface(sp, next);
     case MaterialKind::Dielectric:
       scatter_dielectric(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
       return true;
     case MaterialKind::Coated:
       scatter_coated(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
-      return true;
+      return above_surface(sp, next);
     case MaterialKind::Emissive:
       return false;
   }

@@ -6,14 +6,11 @@
 
 namespace wt {
 
-// Rays start this far along themselves at the earliest (beyond the surface offset
-// this only guards against degenerate self-hits).
-constexpr float kRayTMin = 1e-4f;
 constexpr float kRayTMax = 3.0e38f;
 
 template <class Scene>
 WT_HD WT_INLINE Hit intersect_scene(const Scene& scene, const Ray& ray) {
-  return intersect_closest(scene, ray, kRayTMin, kRayTMax);
+  return intersect_closest(scene, ray, kRayTMax);
 }
 
 // Camera ray of path (pixel, sample).
@@ -30,17 +27,12 @@ WT_HD WT_INLINE Ray primary_ray(const Scene& scene, const RenderParams& rp, uint
 template <class Scene>
 WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const Hit& hit, uint32_t pixel,
                                uint32_t sample, uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance) {
-  SphereGeom s = scene.sphere(hit.sphere);
-  const Material& m = scene.material_of(hit.sphere);
-  SurfacePoint sp;
-  sp.p = ray.at(hit.t);
-  sp.local = sp.p - vec3(s.x, s.y, s.z);
-  sp.n = sp.local * (1.0f / s.w);
-  sp.front = glm::dot(ray.dir, sp.n) < 0.0f;
+  const Material& m = scene.material(material_index(scene, hit));
   if (m.kind == MaterialKind::Emissive) {
     radiance += throughput * m.emission;
     return false;
   }
+  const SurfacePoint sp = surface_at(scene, ray, hit);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   vec3 attenuation;
   Ray next;
@@ -65,7 +57,7 @@ WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint
   for (int bounce = 0; bounce < rp.depth; ++bounce) {
     Hit hit = intersect_scene(scene, ray);
     ++rays;
-    if (hit.sphere < 0) {
+    if (hit.missed()) {
       radiance += throughput * scene.sky.radiance(ray.dir);
       break;
     }

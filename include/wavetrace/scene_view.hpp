@@ -1,16 +1,12 @@
 // A scene as the tracing code sees it: flat arrays in one memory (host or device).
 #pragma once
 
-#include "wavetrace/bvh.hpp"
 #include "wavetrace/camera.hpp"
+#include "wavetrace/geometry/geometry.hpp"
 #include "wavetrace/material.hpp"
 #include "wavetrace/sky.hpp"
 
 namespace wt {
-
-struct alignas(16) SphereGeom {
-  float x, y, z, w;  // centre and radius
-};
 
 // The settings of one render that the per-path code needs.
 struct RenderParams {
@@ -24,22 +20,35 @@ struct RenderParams {
 
 // Scene access through plain pointers (global memory on the GPU, host memory on
 // the CPU). The constant-memory megakernel has an accessor of the same shape.
+// The accessor functions are the ones geometry/geometry.hpp names.
 struct SceneView {
+  const BvhNode* nodes;  // the top level over instances first, then each instance's
+  const Instance* instances;
   const SphereGeom* spheres;
-  const uint32_t* sphere_material;
-  const BvhNode* nodes;
+  const uint32_t* sphere_materials;
+  const TriangleGeom* triangles;
+  const TriangleShading* triangle_shadings;
+  const uint32_t* triangle_materials;
+  const vec3* normals;
+  const vec2* uvs;
   const Material* materials;
   const Texture* textures;
   const ImageView* images;
-  int32_t sphere_count;
   int32_t node_total;
   Sky sky;
   Camera camera;
 
   WT_HD int node_count() const { return node_total; }
   WT_HD BvhNode node(int i) const { return nodes[i]; }
+  WT_HD const Instance& instance(int i) const { return instances[i]; }
   WT_HD SphereGeom sphere(int i) const { return spheres[i]; }
-  WT_HD const Material& material_of(int sphere) const { return materials[sphere_material[sphere]]; }
+  WT_HD uint32_t sphere_material(int i) const { return sphere_materials[i]; }
+  WT_HD TriangleGeom triangle(int i) const { return triangles[i]; }
+  WT_HD TriangleShading triangle_shading(int i) const { return triangle_shadings[i]; }
+  WT_HD uint32_t triangle_material(int i) const { return triangle_materials[i]; }
+  WT_HD vec3 normal(uint32_t i) const { return normals[i]; }
+  WT_HD vec2 uv(uint32_t i) const { return uvs[i]; }
+  WT_HD const Material& material(uint32_t i) const { return materials[i]; }
   WT_HD const Texture* texture_array() const { return textures; }
   WT_HD const ImageView* image_array() const { return images; }
 };

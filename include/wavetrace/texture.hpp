@@ -3,6 +3,7 @@
 // through a CUDA texture object, on the CPU from host memory.
 #pragma once
 
+#include "wavetrace/geometry/surface.hpp"
 #include "wavetrace/rng.hpp"
 
 namespace wt {
@@ -99,9 +100,10 @@ WT_HD WT_INLINE float turbulence(vec3 p, int octaves) {
   return sum;
 }
 
-// local: the hit point relative to the sphere's centre; n: the unit outward normal.
-WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, const vec3& local,
-                                  const vec3& n) {
+// Procedural textures are functions of the object-space point (a sphere's: relative
+// to its centre); images are looked up by the surface's UVs (a sphere's from its normal).
+WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, const SurfacePoint& sp) {
+  const vec3& local = sp.local;
   switch (t.kind) {
     case TextureKind::Checker: {
       int parity = static_cast<int>(floorf(local.x / t.scale)) + static_cast<int>(floorf(local.z / t.scale));
@@ -113,7 +115,7 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
       return t.b + s * (t.a - t.b);
     }
     case TextureKind::Image: {
-      vec2 uv = sphere_uv(n);
+      vec2 uv = sp.has_uv ? sp.uv : sphere_uv(sp.n);
       return sample_image(images[t.image], uv.x, uv.y);
     }
   }

@@ -111,10 +111,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   int64_t wave = wavefront ? choose_wave_size(options.wave_size, rp, info.free_memory) : 0;
   // Checked before allocating anything: a render that cannot fit fails with a
   // message rather than with an allocation error halfway through.
-  size_t scene_bytes = 0;
-  for (const Image& im : scene.images) scene_bytes += im.texels.size() * sizeof(float);
-  scene_bytes += scene.spheres.size() * (sizeof(SphereGeom) + sizeof(uint32_t)) + scene.nodes.size() * sizeof(BvhNode);
-  require_device_memory(rp, render_state_bytes(rp, options.kernel, wave) + scene_bytes, info.free_memory, info.name);
+  require_device_memory(rp, render_state_bytes(rp, options.kernel, wave) + scene.device_bytes(), info.free_memory,
+                        info.name);
 
   auto t0 = std::chrono::steady_clock::now();
   DeviceScene ds(scene, rp.width, rp.height);

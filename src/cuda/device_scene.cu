@@ -7,9 +7,15 @@ constexpr const char* kStage = "scene upload";
 }
 
 DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
+  nodes_.upload(scene.nodes, kStage);
+  instances_.upload(scene.instances, kStage);
   spheres_.upload(scene.spheres, kStage);
   sphere_material_.upload(scene.sphere_material, kStage);
-  nodes_.upload(scene.nodes, kStage);
+  triangles_.upload(scene.triangles, kStage);
+  triangle_shading_.upload(scene.triangle_shading, kStage);
+  triangle_material_.upload(scene.triangle_material, kStage);
+  normals_.upload(scene.normals, kStage);
+  uvs_.upload(scene.uvs, kStage);
   materials_.upload(scene.materials, kStage);
   textures_.upload(scene.textures, kStage);
 
@@ -39,13 +45,18 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   }
   images_.upload(image_views_, kStage);
 
-  view_.spheres = spheres_.get();
-  view_.sphere_material = sphere_material_.get();
   view_.nodes = nodes_.get();
+  view_.instances = instances_.get();
+  view_.spheres = spheres_.get();
+  view_.sphere_materials = sphere_material_.get();
+  view_.triangles = triangles_.get();
+  view_.triangle_shadings = triangle_shading_.get();
+  view_.triangle_materials = triangle_material_.get();
+  view_.normals = normals_.get();
+  view_.uvs = uvs_.get();
   view_.materials = materials_.get();
   view_.textures = textures_.get();
   view_.images = images_.get();
-  view_.sphere_count = static_cast<int32_t>(scene.spheres.size());
   view_.node_total = static_cast<int32_t>(scene.nodes.size());
   view_.sky = scene.sky;
   view_.camera = Camera::make(scene.camera, width, height);

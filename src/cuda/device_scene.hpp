@@ -21,9 +21,15 @@ class DeviceScene {
   const std::vector<ImageView>& image_views() const { return image_views_; }
 
  private:
+  DeviceBuffer<BvhNode> nodes_;
+  DeviceBuffer<Instance> instances_;
   DeviceBuffer<SphereGeom> spheres_;
   DeviceBuffer<uint32_t> sphere_material_;
-  DeviceBuffer<BvhNode> nodes_;
+  DeviceBuffer<TriangleGeom> triangles_;
+  DeviceBuffer<TriangleShading> triangle_shading_;
+  DeviceBuffer<uint32_t> triangle_material_;
+  DeviceBuffer<vec3> normals_;
+  DeviceBuffer<vec2> uvs_;
   DeviceBuffer<Material> materials_;
   DeviceBuffer<Texture> textures_;
   DeviceBuffer<ImageView> images_;

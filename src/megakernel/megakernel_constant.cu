@@ -18,8 +18,9 @@ __constant__ __align__(16) unsigned char c_pool[kPoolBytes];
 
 // Where each array starts in the pool.
 struct ConstantLayout {
-  uint32_t spheres, sphere_material, nodes, materials, textures, images;
-  int32_t sphere_count, node_total;
+  uint32_t nodes, instances, spheres, sphere_materials, triangles, triangle_shadings, triangle_materials, normals, uvs,
+      materials, textures, images;
+  int32_t node_total;
 };
 
 struct ConstantScene {
@@ -33,10 +34,17 @@ struct ConstantScene {
   }
   __device__ int node_count() const { return layout.node_total; }
   __device__ BvhNode node(int i) const { return array<BvhNode>(layout.nodes)[i]; }
+  __device__ const Instance& instance(int i) const { return array<Instance>(layout.instances)[i]; }
   __device__ SphereGeom sphere(int i) const { return array<SphereGeom>(layout.spheres)[i]; }
-  __device__ const Material& material_of(int s) const {
-    return array<Material>(layout.materials)[array<uint32_t>(layout.sphere_material)[s]];
+  __device__ uint32_t sphere_material(int i) const { return array<uint32_t>(layout.sphere_materials)[i]; }
+  __device__ TriangleGeom triangle(int i) const { return array<TriangleGeom>(layout.triangles)[i]; }
+  __device__ TriangleShading triangle_shading(int i) const {
+    return array<TriangleShading>(layout.triangle_shadings)[i];
   }
+  __device__ uint32_t triangle_material(int i) const { return array<uint32_t>(layout.triangle_materials)[i]; }
+  __device__ vec3 normal(uint32_t i) const { return array<vec3>(layout.normals)[i]; }
+  __device__ vec2 uv(uint32_t i) const { return array<vec2>(layout.uvs)[i]; }
+  __device__ const Material& material(uint32_t i) const { return array<Material>(layout.materials)[i]; }
   __device__ const Texture* texture_array() const { return array<Texture>(layout.textures); }
   __device__ const ImageView* image_array() const { return array<ImageView>(layout.images); }
 };
@@ -57,25 +65,31 @@ size_t constant_scene_capacity() { return kPoolBytes; }
 
 void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images) {
   std::vector<unsigned char> pool;
-  auto place = [&pool](const void* data, size_t bytes) {
+  auto place = [&pool](const auto& array) {
+    const size_t bytes = array.size() * sizeof(array[0]);
     size_t offset = align16(pool.size());
     pool.resize(offset + bytes);
-    if (bytes) std::memcpy(pool.data() + offset, data, bytes);
+    if (bytes) std::memcpy(pool.data() + offset, array.data(), bytes);
     return static_cast<uint32_t>(offset);
   };
   ConstantScene cs{};
-  cs.layout.spheres = place(scene.spheres.data(), scene.spheres.size() * sizeof(SphereGeom));
-  cs.layout.sphere_material = place(scene.sphere_material.data(), scene.sphere_material.size() * sizeof(uint32_t));
-  cs.layout.nodes = place(scene.nodes.data(), scene.nodes.size() * sizeof(BvhNode));
-  cs.layout.materials = place(scene.materials.data(), scene.materials.size() * sizeof(Material));
-  cs.layout.textures = place(scene.textures.data(), scene.textures.size() * sizeof(Texture));
-  cs.layout.images = place(images.data(), images.size() * sizeof(ImageView));
+  cs.layout.nodes = place(scene.nodes);
+  cs.layout.instances = place(scene.instances);
+  cs.layout.spheres = place(scene.spheres);
+  cs.layout.sphere_materials = place(scene.sphere_material);
+  cs.layout.triangles = place(scene.triangles);
+  cs.layout.triangle_shadings = place(scene.triangle_shading);
+  cs.layout.triangle_materials = place(scene.triangle_material);
+  cs.layout.normals = place(scene.normals);
+  cs.layout.uvs = place(scene.uvs);
+  cs.layout.materials = place(scene.materials);
+  cs.layout.textures = place(scene.textures);
+  cs.layout.images = place(images);
   if (pool.size() > kPoolBytes) {
     throw SceneError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
                      " bytes of constant memory; megakernel-constant holds at most " + std::to_string(kPoolBytes) +
                      " (use --kernel megakernel)");
   }
-  cs.layout.sphere_count = device_view.sphere_count;
   cs.layout.node_total = device_view.node_total;
   cs.sky = device_view.sky;
   cs.camera = device_view.camera;

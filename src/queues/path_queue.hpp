@@ -25,7 +25,8 @@ struct PathState {
   X(uint32_t, path, path) X(uint32_t, bounce, bounce)
 
 // (element type, array, member of Hit): the closest hit of each slot's ray.
-#define WT_HIT_FIELDS(X) X(float, t, t) X(int32_t, sphere, sphere)
+#define WT_HIT_FIELDS(X) \
+  X(float, t, t) X(int32_t, instance, instance) X(int32_t, prim, prim) X(float, b1, b1) X(float, b2, b2)
 
 WT_SOA_QUEUE(PathQueue, PathState, WT_PATH_FIELDS);
 WT_SOA_QUEUE(HitQueue, Hit, WT_HIT_FIELDS);

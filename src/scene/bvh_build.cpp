@@ -1,75 +1,52 @@
-// Binned-SAH BVH over the scene's spheres, in the layout bvh.hpp traverses.
-#include <algorithm>
-#include <cfloat>
-#include <cmath>
-#include <thread>
+// Binned-SAH BVH over boxes, in the layout geometry/bvh.hpp traverses.
+#include "scene/bvh_build.hpp"
 
-#include "scene/scene.hpp"
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <thread>
 
 namespace wt {
 
 namespace {
 
 constexpr int kBins = 16;
-constexpr int kMaxLeafSize = 4;
-// Traversal defers at most one node per level, and the deferred nodes' depths
-// strictly increase down the stack, so a tree of depth D needs at most D stack
-// entries. Building to three quarters of the stack leaves a margin for later
-// changes to the traversal.
-constexpr int kMaxDepth = kBvhStackSize * 3 / 4;
-// SAH cost of visiting an inner node relative to one sphere test: both are a
-// handful of multiply-adds and a compare.
-constexpr double kTraversalCost = 1.0;
+// The deepest a tree may be (geometry/bvh.hpp sizes the traversal stack by it).
+constexpr int kMaxDepth = kMaxBvhDepth;
 
-struct Box {
-  vec3 lo{FLT_MAX};
-  vec3 hi{-FLT_MAX};
+using Box = Aabb;
 
-  void grow(const Box& b) {
-    lo = glm::min(lo, b.lo);
-    hi = glm::max(hi, b.hi);
-  }
-  void grow(const vec3& p) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  // In double: areas of scene-sized boxes times sphere counts overflow a float.
-  double area() const {
-    glm::dvec3 d = glm::dvec3(hi) - glm::dvec3(lo);
-    return d.x < 0.0 ? 0.0 : 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x);
-  }
-};
-
-// Levels that median splits need to bring `count` spheres down to leaves.
-int median_levels(int count) {
+// Levels that median splits need to bring `count` primitives down to leaves.
+int median_levels(int count, int max_leaf_size) {
   int levels = 0;
-  for (int leaves = (count + kMaxLeafSize - 1) / kMaxLeafSize; leaves > 1; leaves = (leaves + 1) / 2) ++levels;
+  for (int leaves = (count + max_leaf_size - 1) / max_leaf_size; leaves > 1; leaves = (leaves + 1) / 2) ++levels;
   return levels;
 }
 
 struct Split {
   int axis = -1;
-  int bin = 0;  // spheres in bins < bin go left
+  int bin = 0;  // primitives in bins < bin go left
   double cost = DBL_MAX;
 };
 
-// A sphere as the builder moves it: partitions permute these records in place, so
+// A primitive as the builder moves it: partitions permute these records in place, so
 // every pass over a node's range reads contiguous memory.
 struct Item {
   Box bounds;
   vec3 centroid;
-  uint32_t sphere;
+  uint32_t prim;
 };
 
-// Subtrees of at least this many spheres are built on a thread of their own, down
+// Subtrees of at least this many primitives are built on a thread of their own, down
 // to the depth that gives every core one.
 constexpr int kParallelMinCount = 1 << 15;
 
 class Builder {
  public:
   // Builds the subtree of items [first, first + count) into `nodes`, its root at `node`.
-  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes, int parallel_depth)
-      : items_(items), nodes_(nodes), parallel_depth_(parallel_depth) {}
+  Builder(std::vector<Item>& items, std::vector<BvhNode>& nodes, const BvhBuildOptions& options, int parallel_depth)
+      : items_(items), nodes_(nodes), options_(options), parallel_depth_(parallel_depth) {}
 
   void build(int node, int first, int count, int depth) {
     Box box, centroids;
@@ -85,8 +62,8 @@ class Builder {
 
     Split split = best_split(first, count, centroids);
     double leaf_cost = count;
-    double split_cost = kTraversalCost + split.cost / box.area();
-    if (count <= kMaxLeafSize && (split.axis < 0 || leaf_cost <= split_cost || depth == kMaxDepth)) {
+    double split_cost = options_.traversal_cost + split.cost / box.area();
+    if (count <= options_.max_leaf_size && (split.axis < 0 || leaf_cost <= split_cost || depth == kMaxDepth)) {
       n.left_or_first = first;
       n.count = count;
       return;
@@ -94,7 +71,7 @@ class Builder {
 
     int left_count = split.axis < 0 ? 0 : partition(first, count, centroids, split);
     int larger = std::max(left_count, count - left_count);
-    if (split.axis < 0 || depth + 1 + median_levels(larger) > kMaxDepth) left_count = median(first, count, centroids);
+    if (split.axis < 0 || depth + 1 + median_levels(larger, options_.max_leaf_size) > kMaxDepth) left_count = median(first, count, centroids);
 
     int left = static_cast<int>(nodes_.size());
     nodes_[node].left_or_first = left;
@@ -105,7 +82,7 @@ class Builder {
       // the right one's nodes follow the left one's, as a serial build lays them out.
       std::vector<BvhNode> right_nodes(1);
       right_nodes.reserve(2 * (count - left_count));
-      Builder right(items_, right_nodes, parallel_depth_);
+      Builder right(items_, right_nodes, options_, parallel_depth_);
       std::thread worker([&] { right.build(0, first + left_count, count - left_count, depth + 1); });
       build(left, first, left_count, depth + 1);
       worker.join();
@@ -134,7 +111,7 @@ class Builder {
     return std::min(std::max(b, 0), kBins - 1);
   }
 
-  // Cost is the children's area-weighted sphere counts; no split when the centroids
+  // Cost is the children's area-weighted primitive counts; no split when the centroids
   // coincide on every axis.
   Split best_split(int first, int count, const Box& centroids) const {
     Split best;
@@ -189,47 +166,62 @@ class Builder {
 
   std::vector<Item>& items_;
   std::vector<BvhNode>& nodes_;
+  const BvhBuildOptions& options_;
   int parallel_depth_;
 };
 
 }  // namespace
 
-void build_bvh(Scene& scene) {
-  scene.nodes.clear();
-  if (scene.spheres.empty()) return;
-  // Node and sphere indices are int32 on the device; median splits of this many
-  // spheres fit within the depth limit.
-  const size_t count = scene.spheres.size();
-  if (count > static_cast<size_t>(INT32_MAX / 2) || median_levels(static_cast<int>(count)) > kMaxDepth) {
-    throw SceneError(scene.source + ": /spheres: too many spheres for the BVH (" + std::to_string(count) + ")");
+BvhTree build_bvh(const std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options) {
+  // Node and primitive indices are int32 on the device; median splits of this many
+  // primitives must fit within the depth limit.
+  const size_t count = prims.size();
+  if (count == 0) throw std::length_error("a BVH needs at least one primitive");
+  if (count > static_cast<size_t>(INT32_MAX / 2) ||
+      median_levels(static_cast<int>(count), options.max_leaf_size) > kMaxDepth) {
+    throw std::length_error("too many primitives for the BVH (" + std::to_string(count) + ")");
   }
-
   std::vector<Item> items(count);
-  for (size_t i = 0; i < count; ++i) {
-    const SphereGeom& s = scene.spheres[i];
-    vec3 c(s.x, s.y, s.z);
-    // The slab test and the sphere test round differently; a box a little larger
-    // than the sphere keeps a grazing hit from being culled by its own box.
-    float pad = 1e-5f * (std::max({std::fabs(s.x), std::fabs(s.y), std::fabs(s.z)}) + s.w);
-    items[i].bounds.lo = c - vec3(s.w + pad);
-    items[i].bounds.hi = c + vec3(s.w + pad);
-    items[i].centroid = c;
-    items[i].sphere = static_cast<uint32_t>(i);
-  }
+  for (size_t i = 0; i < count; ++i) items[i] = Item{prims[i].box, prims[i].centroid, static_cast<uint32_t>(i)};
   int parallel_depth = 0;
   for (unsigned cores = std::thread::hardware_concurrency(); (1u << parallel_depth) < cores;) ++parallel_depth;
-  scene.nodes.reserve(2 * count);
-  scene.nodes.resize(1);
-  Builder(items, scene.nodes, parallel_depth).build(0, 0, static_cast<int>(count), 0);
+  BvhTree tree;
+  tree.nodes.reserve(2 * count);
+  tree.nodes.resize(1);
+  Builder(items, tree.nodes, options, parallel_depth).build(0, 0, static_cast<int>(count), 0);
+  tree.order.resize(count);
+  for (size_t i = 0; i < count; ++i) tree.order[i] = items[i].prim;
+  return tree;
+}
 
-  std::vector<SphereGeom> spheres(count);
-  std::vector<uint32_t> materials(count);
-  for (size_t i = 0; i < count; ++i) {
-    spheres[i] = scene.spheres[items[i].sphere];
-    materials[i] = scene.sphere_material[items[i].sphere];
+BvhStats bvh_stats(const std::vector<BvhNode>& nodes, const BvhBuildOptions& options) {
+  BvhStats stats;
+  if (nodes.empty()) return stats;
+  auto area = [](const BvhNode& n) {
+    Aabb b;
+    b.lo = vec3(n.lo[0], n.lo[1], n.lo[2]);
+    b.hi = vec3(n.hi[0], n.hi[1], n.hi[2]);
+    return b.area();
+  };
+  const double root_area = area(nodes[0]);
+  std::vector<std::pair<int, int>> todo{{0, 1}};  // (node, depth)
+  while (!todo.empty()) {
+    auto [i, depth] = todo.back();
+    todo.pop_back();
+    const BvhNode& n = nodes[i];
+    ++stats.nodes;
+    stats.depth = std::max(stats.depth, depth);
+    const double p = root_area > 0.0 ? area(n) / root_area : 1.0;
+    if (n.count > 0) {
+      ++stats.leaves;
+      stats.sah_cost += p * n.count;
+    } else {
+      stats.sah_cost += p * options.traversal_cost;
+      todo.push_back({n.left_or_first, depth + 1});
+      todo.push_back({n.left_or_first + 1, depth + 1});
+    }
   }
-  scene.spheres = std::move(spheres);
-  scene.sphere_material = std::move(materials);
+  return stats;
 }
 
 }  // namespace wt

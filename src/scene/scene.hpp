@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "scene/bvh_build.hpp"
 #include "wavetrace/scene_view.hpp"
 
 namespace wt {
@@ -42,8 +43,32 @@ struct LoadTimes {
   double parse = 0;         // reading the file and parsing the JSON
   double validate = 0;      // checking every field and building the scene's arrays
   double texture_load = 0;  // decoding image textures (not part of validate)
+  double mesh_load = 0;  // reading mesh files (not part of validate)
   double bvh_build = 0;
 };
+
+// One mesh file as the scene holds it: a range of the scene's triangle arrays,
+// with its own BVH, however many instances place it.
+struct SceneMesh {
+  std::string name;
+  std::string file;
+  uint32_t first_triangle = 0;
+  uint32_t triangle_count = 0;
+  size_t dropped_degenerate = 0;  // triangles the loader dropped (mesh_load.hpp)
+  size_t dropped_nan = 0;
+  BvhStats bvh;
+};
+
+// Where a group of primitives stands in the world: one entry of the scene file's
+// `instances` (or the spheres, which stand untransformed).
+struct Placement {
+  int32_t mesh;  // index into Scene::meshes; kSpheres: the scene's spheres
+  Affine world_from_object;
+  Affine object_from_world;
+  bool identity;
+  int32_t material;  // an override; < 0: the primitives' own
+};
+constexpr int32_t kSpheres = -1;
 
 struct Scene {
   std::string source;  // the scene file
@@ -56,8 +81,26 @@ struct Scene {
   std::vector<std::string> material_names;
   std::vector<SphereGeom> spheres;          // in BVH order once built
   std::vector<uint32_t> sphere_material;    // per sphere, in BVH order
+  // Every mesh's triangles, one contiguous range per mesh, in BVH order once built.
+  std::vector<TriangleGeom> triangles;
+  std::vector<TriangleShading> triangle_shading;
+  std::vector<uint32_t> triangle_material;
+  std::vector<vec3> normals;  // per vertex, of the meshes that have them
+  std::vector<vec2> uvs;
+  std::vector<SceneMesh> meshes;
+  std::vector<Placement> placements;
+  // Built from the above by build_bvh: the instances in top-level order and the
+  // node array (the top level first, then the spheres' and each mesh's tree).
+  std::vector<Instance> instances;
   std::vector<BvhNode> nodes;
+  BvhStats top_level_bvh;
+  BvhStats sphere_bvh;
   LoadTimes load_times;
+
+  // Triangles placed, counting each instance's: what the scene renders.
+  size_t instanced_triangles() const;
+  // What the scene's arrays and images take on the device.
+  size_t device_bytes() const;
 
   // Number of low bits that hold every sort key the scene's materials use (at least 1).
   int sort_key_bits() const;
@@ -71,7 +114,8 @@ Scene load_scene(const std::string& path);
 // relative texture paths.
 Scene parse_scene(const std::string& json_text, const std::string& source);
 
-// Builds the BVH over scene.spheres, reordering spheres and sphere_material.
+// Builds the bottom-level BVHs (over the spheres, and over each mesh's triangles,
+// reordering their arrays), the instances and the top-level BVH over them.
 void build_bvh(Scene& scene);
 
 // A host view of the scene (pointers into `scene`) for a render of width x height,

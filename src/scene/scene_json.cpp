@@ -11,7 +11,7 @@ namespace wt {
 
 void SceneReader::read(const json& root) {
   const JsonPath top;
-  check_keys(root, top, {"camera", "sky", "render", "textures", "materials", "spheres"});
+  check_keys(root, top, {"camera", "sky", "render", "textures", "materials", "spheres", "meshes", "instances"});
   read_camera(required(root, top, "camera"), top / "camera");
   if (root.contains("sky")) read_sky(root["sky"], top / "sky");
   if (root.contains("render")) read_render(root["render"], top / "render");
@@ -23,12 +23,21 @@ void SceneReader::read(const json& root) {
   const JsonPath materials_path = top / "materials";
   const json& materials = array(required(root, top, "materials"), materials_path);
   for (size_t i = 0; i < materials.size(); ++i) read_material(materials[i], materials_path / i);
-  const JsonPath spheres_path = top / "spheres";
-  const json& spheres = array(required(root, top, "spheres"), spheres_path);
-  if (spheres.empty()) fail_at(spheres_path, "must contain at least one sphere");
-  scene_.spheres.reserve(spheres.size());
-  scene_.sphere_material.reserve(spheres.size());
-  for (size_t i = 0; i < spheres.size(); ++i) read_sphere(spheres[i], spheres_path / i);
+  if (root.contains("spheres")) {
+    const JsonPath path = top / "spheres";
+    const json& spheres = array(root["spheres"], path);
+    scene_.spheres.reserve(spheres.size());
+    scene_.sphere_material.reserve(spheres.size());
+    for (size_t i = 0; i < spheres.size(); ++i) read_sphere(spheres[i], path / i);
+    if (!spheres.empty()) scene_.placements.push_back(Placement{kSpheres, kIdentityTransform, kIdentityTransform, true, -1});
+  }
+  if (root.contains("meshes")) read_meshes(array(root["meshes"], top / "meshes"), top / "meshes");
+  if (root.contains("instances")) {
+    const JsonPath path = top / "instances";
+    const json& instances = array(root["instances"], path);
+    for (size_t i = 0; i < instances.size(); ++i) read_instance(instances[i], path / i);
+  }
+  if (scene_.placements.empty()) fail_at(top, "the scene has nothing to render: no spheres and no instances");
 }
 
 const std::string& SceneReader::name(const json& obj, const JsonPath& path) const {
@@ -89,7 +98,8 @@ Scene prepare(json root, const std::string& source, double parse_seconds) {
   SceneReader reader(source, scene);
   reader.read(root);
   scene.load_times.texture_load = reader.texture_seconds();
-  scene.load_times.validate = seconds_since(start) - scene.load_times.texture_load;
+  scene.load_times.mesh_load = reader.mesh_seconds();
+  scene.load_times.validate = seconds_since(start) - scene.load_times.texture_load - scene.load_times.mesh_load;
   std::thread release([document = std::move(root)]() mutable { json().swap(document); });
   start = Clock::now();
   try {
@@ -130,13 +140,18 @@ SceneView host_view(const Scene& scene, int width, int height, std::vector<Image
   image_views.clear();
   for (const Image& im : scene.images) image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height});
   SceneView v{};
-  v.spheres = scene.spheres.data();
-  v.sphere_material = scene.sphere_material.data();
   v.nodes = scene.nodes.data();
+  v.instances = scene.instances.data();
+  v.spheres = scene.spheres.data();
+  v.sphere_materials = scene.sphere_material.data();
+  v.triangles = scene.triangles.data();
+  v.triangle_shadings = scene.triangle_shading.data();
+  v.triangle_materials = scene.triangle_material.data();
+  v.normals = scene.normals.data();
+  v.uvs = scene.uvs.data();
   v.materials = scene.materials.data();
   v.textures = scene.textures.data();
   v.images = image_views.data();
-  v.sphere_count = static_cast<int32_t>(scene.spheres.size());
   v.node_total = static_cast<int32_t>(scene.nodes.size());
   v.sky = scene.sky;
   v.camera = Camera::make(scene.camera, width, height);

@@ -1,6 +1,7 @@
 // The scene-file reader (docs/scene-format.md), one source file per section:
 // scene_json.cpp (the document, shared field readers, loading), scene_camera.cpp
-// (camera, sky, render), scene_textures.cpp, scene_materials.cpp, scene_geometry.cpp.
+// (camera, sky, render), scene_textures.cpp, scene_materials.cpp, scene_geometry.cpp
+// (spheres), scene_meshes.cpp (meshes and instances); scene_bvh.cpp builds the BVHs.
 // Internal to src/scene; the rest of the project calls load_scene / parse_scene.
 #pragma once
 
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "scene/json_reader.hpp"
+#include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
 
 namespace wt {
@@ -32,6 +34,7 @@ class SceneReader : JsonReader {
   void read(const json& root);
 
   double texture_seconds() const { return texture_seconds_; }
+  double mesh_seconds() const { return mesh_seconds_; }
 
  private:
   // Field readers shared by the sections (scene_json.cpp).
@@ -51,13 +54,25 @@ class SceneReader : JsonReader {
   // scene_textures.cpp
   void read_texture(const json& j, const JsonPath& path);
   // Textures that name the same file in the same colorspace share one image.
+  // `file` relative to the scene file; an error names the field.
   int32_t image(const std::string& file, bool srgb, const JsonPath& path);
+  // `resolved` as it is; an error names `referrer` (a mesh file whose material uses it).
+  int32_t image_file(const std::string& resolved, bool srgb, const std::string& referrer);
+  // The image's index, or -1 with the reason in `why`.
+  int32_t image_at(const std::string& resolved, bool srgb, std::string& why);
 
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);
 
   // scene_geometry.cpp
   void read_sphere(const json& j, const JsonPath& path);
+
+  // scene_meshes.cpp
+  void read_meshes(const json& list, const JsonPath& path);
+  void add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override);
+  void read_instance(const json& j, const JsonPath& path);
+  // A material's index by its name in the scene file.
+  int32_t material_named(const json& j, const JsonPath& path) const;
 
   // Name -> (index, JSON path of the definition).
   using Names = std::map<std::string, std::pair<size_t, std::string>>;
@@ -68,8 +83,10 @@ class SceneReader : JsonReader {
   std::filesystem::path base_dir_;
   Names texture_names_;
   Names material_names_;
+  Names mesh_names_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;
+  double mesh_seconds_ = 0;
 };
 
 }  // namespace wt

@@ -45,6 +45,20 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
 
 int32_t SceneReader::image(const std::string& file, bool srgb, const JsonPath& path) {
   std::string resolved = (base_dir_ / file).lexically_normal().string();
+  std::string why;
+  int32_t index = image_at(resolved, srgb, why);
+  if (index < 0) fail_at(path, "cannot read image '" + resolved + "' (" + why + ")");
+  return index;
+}
+
+int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const std::string& referrer) {
+  std::string why;
+  int32_t index = image_at(resolved, srgb, why);
+  if (index < 0) throw SceneError(referrer + ": cannot read texture image '" + resolved + "' (" + why + ")");
+  return index;
+}
+
+int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::string& why) {
   auto known = images_.find({resolved, srgb});
   if (known != images_.end()) return known->second;
 
@@ -53,7 +67,10 @@ int32_t SceneReader::image(const std::string& file, bool srgb, const JsonPath& p
   // bookworm) reads past its buffer when it converts a 16-bit PNM to 4 channels.
   int w = 0, h = 0, channels = 0;
   stbi_uc* data = stbi_load(resolved.c_str(), &w, &h, &channels, 0);
-  if (!data) fail_at(path, "cannot read image '" + resolved + "' (" + stbi_failure_reason() + ")");
+  if (!data) {
+    why = stbi_failure_reason();
+    return -1;
+  }
   Image im;
   im.path = resolved;
   im.width = w;

@@ -18,13 +18,13 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
                                        const PathQueue& q, const HitQueue& hits, float* film) {
   Hit h = intersect_scene(scene, ray);
   hits.store(i, h);
-  if (h.sphere < 0) {
+  if (h.missed()) {
     const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);
     accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir));
     return pack_entry(kSortKeyMiss, i);
   }
-  return pack_entry(scene.material_of(h.sphere).sort_key, i);
+  return pack_entry(scene.material(material_index(scene, h)).sort_key, i);
 }
 
 // Slot i's ray as the queue holds it.

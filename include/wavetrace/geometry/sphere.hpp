@@ -1,10 +1,22 @@
-// Ray-sphere intersection, robust for rays that start inside a sphere, for grazing
-// rays and for spheres far larger than the distances between them (the ground).
+// The sphere primitive: its record, its intersection (robust for rays that start
+// inside a sphere, for grazing rays and for spheres far larger than the distances
+// between them: the ground) and its surface.
 #pragma once
 
-#include "wavetrace/ray.hpp"
+#include "wavetrace/geometry/surface.hpp"
 
 namespace wt {
+
+struct alignas(16) SphereGeom {
+  float x, y, z, w;  // centre and radius
+};
+
+// A sphere hit closer than this along the ray is the surface the ray just left.
+constexpr float kSphereTMin = 1e-4f;
+// Secondary rays leave a sphere this far along the normal. Spheres keep the fixed
+// offset the reference images were rendered with; triangles derive theirs from
+// the hit point's error bound (triangle.hpp).
+constexpr float kSphereSurfaceOffset = 1e-3f;
 
 // The nearest root of |o + t d - c|^2 = r^2 in (tmin, tmax), for unit d.
 // The discriminant is formed from the perpendicular distance of the centre to the
@@ -42,6 +54,21 @@ WT_HD WT_INLINE bool intersect_sphere(const Ray& ray, const vec3& center, float 
     return true;
   }
   return false;
+}
+
+// The surface at t along `ray` (whose direction is unit: spheres are placed only
+// untransformed).
+WT_HD WT_INLINE SurfacePoint sphere_surface(const SphereGeom& s, const Ray& ray, float t) {
+  SurfacePoint sp;
+  sp.p = ray.at(t);
+  sp.local = sp.p - vec3(s.x, s.y, s.z);
+  sp.n = sp.local * (1.0f / s.w);
+  sp.ng = sp.n;
+  sp.uv = vec2(0.0f);
+  sp.has_uv = false;
+  sp.front = glm::dot(ray.dir, sp.n) < 0.0f;
+  sp.offset = kSphereSurfaceOffset;
+  return sp;
 }
 
 }  // namespace wt

@@ -1,0 +1,42 @@
+// The bounding volume hierarchy's node layout and the slab test. One node array
+// holds the top level (over instances) and every bottom level (over one group of
+// primitives); traverse.hpp walks both.
+#pragma once
+
+#include "wavetrace/ray.hpp"
+
+namespace wt {
+
+// Two 16-byte rows: the bounds, and either the first of two adjacent children
+// (inner node, count == 0) or the first primitive and the primitive count (leaf).
+struct alignas(16) BvhNode {
+  float lo[3];
+  int32_t left_or_first;
+  float hi[3];
+  int32_t count;
+};
+
+// The deepest the builder makes a tree. Traversal defers at most one node per
+// level, and the deferred nodes' depths strictly increase down the stack, so a
+// tree of depth D needs at most D stack entries; two levels and the entry that
+// marks the return from an instance need twice that and one more.
+constexpr int kMaxBvhDepth = 24;
+constexpr int kBvhStackSize = 2 * kMaxBvhDepth + 1;
+
+// The slab test's far distances are rounded up by this factor (1 + 2 gamma(3) of
+// the three rounded operations behind each): a ray through an edge or corner that
+// lies on a box's face is never culled by the box's rounding, which the watertight
+// triangle test relies on.
+constexpr float kSlabRoundUp = 1.0000004f;
+
+// Slab test; returns the entry distance or a value > tmax when the box is missed.
+WT_HD WT_INLINE float box_entry(const BvhNode& n, const vec3& o, const vec3& inv, float tmax) {
+  float tx0 = (n.lo[0] - o.x) * inv.x, tx1 = (n.hi[0] - o.x) * inv.x;
+  float ty0 = (n.lo[1] - o.y) * inv.y, ty1 = (n.hi[1] - o.y) * inv.y;
+  float tz0 = (n.lo[2] - o.z) * inv.z, tz1 = (n.hi[2] - o.z) * inv.z;
+  float tnear = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), 0.0f));
+  float tfar = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)) * kSlabRoundUp, fminf(fmaxf(tz0, tz1) * kSlabRoundUp, tmax));
+  return tnear <= tfar ? tnear : tmax * 2.0f + 1.0f;
+}
+
+}  // namespace wt

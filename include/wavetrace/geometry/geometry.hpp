@@ -1,0 +1,198 @@
+// The geometry module's interface to the rest of the renderer: the closest hit of a
+// ray, and the surface and material of a hit, whatever the primitive kind. A new
+// kind of primitive is a header beside sphere.hpp and triangle.hpp, a case in each
+// switch here, and its bounds in the host's scene builder; no kernel changes.
+//
+// The scene accessor `g` (SceneView, or the constant-memory scene) provides
+// node_count(), node(i), instance(i), sphere(i), sphere_material(i), triangle(i),
+// triangle_shading(i), triangle_material(i), normal(i) and uv(i).
+#pragma once
+
+#include "wavetrace/geometry/bvh.hpp"
+#include "wavetrace/geometry/instance.hpp"
+#include "wavetrace/geometry/sphere.hpp"
+#include "wavetrace/geometry/triangle.hpp"
+
+namespace wt {
+
+// The stack entry that marks the return from an instance's BVH to the top level.
+constexpr int kReturnToWorld = -1;
+
+// Tests the `count` primitives from `first` of an instance of `kind`, narrowing `hit`.
+template <class Geometry>
+WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int instance, int first, int count,
+                                    const Ray& ray, const TriangleRay& tr, Hit& hit) {
+  for (int prim = first; prim < first + count; ++prim) {
+    float t, b1 = 0.0f, b2 = 0.0f;
+    bool found = false;
+    switch (kind) {
+      case PrimitiveKind::Sphere: {
+        const SphereGeom s = g.sphere(prim);
+        found = intersect_sphere(ray, vec3(s.x, s.y, s.z), s.w, kSphereTMin, hit.t, t);
+        break;
+      }
+      case PrimitiveKind::Triangle:
+        found = intersect_triangle(g.triangle(prim), ray.origin, tr, hit.t, t, b1, b2);
+        break;
+    }
+    if (found) hit = Hit{t, instance, prim, b1, b2};
+  }
+}
+
+// The closest hit along `world` before tmax. The top-level BVH's leaves are single
+// instances; entering one moves the ray into the instance's object space (where t
+// measures the same distances: the direction is transformed, not renormalised) and
+// pushes the mark of the way back.
+template <class Geometry>
+WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
+  Hit hit{tmax, -1, -1, 0.0f, 0.0f};
+  if (g.node_count() == 0) return hit;
+  const vec3 world_inv(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
+  Ray ray = world;
+  vec3 inv = world_inv;
+  TriangleRay tr{};
+  int instance = -1;
+  PrimitiveKind kind = PrimitiveKind::Sphere;
+  int stack[kBvhStackSize];
+  float stack_t[kBvhStackSize];
+  int top = 0;
+  int node = 0;
+  for (;;) {
+    BvhNode n = g.node(node);
+    if (n.count > 0 && instance < 0) {
+      instance = n.left_or_first;
+      const Instance& in = g.instance(instance);
+      kind = in.kind;
+      if (!in.identity) {
+        ray.origin = in.object_from_world.point(world.origin);
+        ray.dir = in.object_from_world.vector(world.dir);
+        inv = vec3(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
+      }
+      if (kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
+      if (top < kBvhStackSize) {
+        stack[top] = kReturnToWorld;
+        stack_t[top++] = 0.0f;
+      }
+      node = in.root;
+      continue;
+    }
+    if (n.count > 0) {
+      intersect_leaf(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
+    } else {
+      int a = n.left_or_first, b = n.left_or_first + 1;
+      float ta = box_entry(g.node(a), ray.origin, inv, hit.t);
+      float tb = box_entry(g.node(b), ray.origin, inv, hit.t);
+      if (ta > tb) {
+        float tt = ta;
+        ta = tb;
+        tb = tt;
+        int ti = a;
+        a = b;
+        b = ti;
+      }
+      if (ta <= hit.t) {
+        if (tb <= hit.t && top < kBvhStackSize) {
+          stack[top] = b;
+          stack_t[top++] = tb;
+        }
+        node = a;
+        continue;
+      }
+    }
+    // Pop, skipping nodes whose boxes the closest hit so far already passed.
+    bool found = false;
+    while (top > 0) {
+      --top;
+      if (stack[top] == kReturnToWorld) {
+        instance = -1;
+        ray = world;
+        inv = world_inv;
+        continue;
+      }
+      if (stack_t[top] <= hit.t) {
+        node = stack[top];
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+  return hit;
+}
+
+// The material a hit shades with: the instance's override, or the primitive's own.
+template <class Geometry>
+WT_HD WT_INLINE uint32_t material_index(const Geometry& g, const Hit& hit) {
+  const Instance& in = g.instance(hit.instance);
+  if (in.material >= 0) return static_cast<uint32_t>(in.material);
+  switch (in.kind) {
+    case PrimitiveKind::Sphere:
+      return g.sphere_material(hit.prim);
+    case PrimitiveKind::Triangle:
+      return g.triangle_material(hit.prim);
+  }
+  return 0;
+}
+
+// A triangle's surface: the point from the barycentric weights (more precise than
+// the ray's t) with its error bound carried into world space, the geometric normal,
+// and the shading normal and UVs where the mesh has them. The geometric normal is
+// turned to the shading normal's side, so that "outward" is what the mesh's normals
+// say it is whatever the winding.
+template <class Geometry>
+WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance& in, const Ray& ray, const Hit& hit) {
+  const TriangleGeom tri = g.triangle(hit.prim);
+  SurfacePoint sp;
+  vec3 error;
+  const vec3 p = triangle_point(tri, hit.b1, hit.b2, error);
+  const vec3 ng = glm::cross(tri.corner(1) - tri.corner(0), tri.corner(2) - tri.corner(0));
+  if (in.identity) {
+    sp.p = p;
+    sp.ng = glm::normalize(ng);
+  } else {
+    const Affine& m = in.world_from_object;
+    sp.p = m.point(p);
+    error = (1.0f + rounding_gamma(3)) * m.abs_vector(error) +
+            rounding_gamma(3) * (m.abs_vector(glm::abs(p)) + m.abs_translation());
+    sp.ng = glm::normalize(in.object_from_world.transposed_vector(ng));
+  }
+  sp.local = p;
+  const TriangleShading sh = g.triangle_shading(hit.prim);
+  const float b0 = 1.0f - hit.b1 - hit.b2;
+  sp.n = sp.ng;
+  if (sh.flags & kTriangleHasNormals) {
+    vec3 n = b0 * g.normal(sh.vertex[0]) + hit.b1 * g.normal(sh.vertex[1]) + hit.b2 * g.normal(sh.vertex[2]);
+    if (!in.identity) n = in.object_from_world.transposed_vector(n);
+    const float len2 = glm::dot(n, n);
+    if (len2 > 0.0f) {
+      sp.n = n * (1.0f / sqrtf(len2));
+      if (glm::dot(sp.n, sp.ng) < 0.0f) sp.ng = -sp.ng;
+    }
+  }
+  if (sh.flags & kTriangleHasUvs) {
+    sp.uv = b0 * g.uv(sh.vertex[0]) + hit.b1 * g.uv(sh.vertex[1]) + hit.b2 * g.uv(sh.vertex[2]);
+  } else {
+    sp.uv = vec2(hit.b1, hit.b2);
+  }
+  sp.has_uv = true;
+  sp.front = glm::dot(ray.dir, sp.ng) < 0.0f;
+  // The point's error along the normal, and the rounding of adding the offset to it
+  // (half an ulp of each coordinate, bounded by 2^-23 |p| with margin).
+  sp.offset = glm::dot(glm::abs(sp.ng), error + 1.1920929e-7f * glm::abs(sp.p));
+  return sp;
+}
+
+// The surface at a hit of `ray` (in world space).
+template <class Geometry>
+WT_HD WT_INLINE SurfacePoint surface_at(const Geometry& g, const Ray& ray, const Hit& hit) {
+  const Instance& in = g.instance(hit.instance);
+  switch (in.kind) {
+    case PrimitiveKind::Sphere:
+      return sphere_surface(g.sphere(hit.prim), ray, hit.t);
+    case PrimitiveKind::Triangle:
+      return triangle_surface(g, in, ray, hit);
+  }
+  return sphere_surface(g.sphere(hit.prim), ray, hit.t);
+}
+
+}  // namespace wt

@@ -1,0 +1,33 @@
+// What shading needs to know about a hit, whatever the primitive, and how a
+// secondary ray leaves the surface without hitting it again.
+#pragma once
+
+#include "wavetrace/ray.hpp"
+
+namespace wt {
+
+struct SurfacePoint {
+  vec3 p;       // world position
+  vec3 n;       // unit shading normal, on the outward side
+  vec3 ng;      // unit geometric normal, outward
+  vec3 local;   // object-space position (procedural textures): relative to a sphere's centre
+  vec2 uv;      // texture coordinates (triangles); spheres map theirs from n (texture.hpp)
+  bool has_uv;  // false: spheres
+  bool front;   // the ray arrived from the outward side
+  float offset;  // how far a secondary ray starts from p along ng: covers p's rounding error
+};
+
+// Floating-point rounding bound gamma(n) = n u / (1 - n u), u = 2^-24: the relative
+// error of n rounded operations.
+WT_HD WT_INLINE constexpr float rounding_gamma(int n) {
+  return (n * 5.9604645e-8f) / (1.0f - n * 5.9604645e-8f);
+}
+
+// A ray from the hit along `dir`, started `offset` along the geometric normal on the
+// side `dir` goes to, so that it cannot hit the surface it leaves.
+WT_HD WT_INLINE Ray spawn_ray(const SurfacePoint& sp, const vec3& dir) {
+  float side = glm::dot(dir, sp.ng) >= 0.0f ? 1.0f : -1.0f;
+  return Ray{sp.p + (side * sp.offset) * sp.ng, dir};
+}
+
+}  // namespace wt

@@ -1,0 +1,181 @@
+// The scene's acceleration structure: a BVH per group of primitives (the spheres,
+// each mesh), the instances that place them, and the top-level BVH over those.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "scene/scene.hpp"
+
+namespace wt {
+
+namespace {
+
+// Spheres: a box a little larger than the sphere, because the slab test and the
+// sphere test round differently, and a grazing hit must not be culled by its box.
+BuildPrimitive sphere_primitive(const SphereGeom& s) {
+  const vec3 c(s.x, s.y, s.z);
+  const float pad = 1e-5f * (std::max({std::fabs(s.x), std::fabs(s.y), std::fabs(s.z)}) + s.w);
+  BuildPrimitive p;
+  p.box.lo = c - vec3(s.w + pad);
+  p.box.hi = c + vec3(s.w + pad);
+  p.centroid = c;
+  return p;
+}
+
+// Triangles: the corners' box is exact, and the slab test rounds its far side up.
+BuildPrimitive triangle_primitive(const TriangleGeom& t) {
+  BuildPrimitive p;
+  for (int i = 0; i < 3; ++i) p.box.grow(t.corner(i));
+  p.centroid = p.box.centre();
+  return p;
+}
+
+template <class T>
+void permute_range(std::vector<T>& v, size_t first, const std::vector<uint32_t>& order) {
+  std::vector<T> out(order.size());
+  for (size_t i = 0; i < order.size(); ++i) out[i] = v[first + order[i]];
+  std::copy(out.begin(), out.end(), v.begin() + first);
+}
+
+// Appends a bottom-level tree to the node array; its leaves' primitive indices move
+// by `first_prim`. Returns the root's index.
+int32_t append_tree(std::vector<BvhNode>& nodes, const std::vector<BvhNode>& tree, uint32_t first_prim) {
+  const int32_t base = static_cast<int32_t>(nodes.size());
+  for (BvhNode n : tree) {
+    n.left_or_first += n.count > 0 ? static_cast<int32_t>(first_prim) : base;
+    nodes.push_back(n);
+  }
+  return base;
+}
+
+Aabb node_box(const BvhNode& n) {
+  Aabb b;
+  b.lo = vec3(n.lo[0], n.lo[1], n.lo[2]);
+  b.hi = vec3(n.hi[0], n.hi[1], n.hi[2]);
+  return b;
+}
+
+// The world box of an instance: its tree's root box through the transform, widened
+// by the rounding of the transform (rays are carried the other way, into object
+// space, and must not be culled here where they hit there).
+Aabb world_box(const Aabb& object, const Placement& p) {
+  if (p.identity) return object;
+  Aabb w;
+  for (int corner = 0; corner < 8; ++corner) {
+    vec3 c((corner & 1) ? object.hi.x : object.lo.x, (corner & 2) ? object.hi.y : object.lo.y,
+           (corner & 4) ? object.hi.z : object.lo.z);
+    w.grow(p.world_from_object.point(c));
+  }
+  const vec3 pad = 1e-5f * glm::max(glm::abs(w.lo), glm::abs(w.hi));
+  w.lo -= pad;
+  w.hi += pad;
+  return w;
+}
+
+}  // namespace
+
+void build_bvh(Scene& scene) {
+  scene.nodes.clear();
+  scene.instances.clear();
+  if (scene.placements.empty()) return;
+  const BvhBuildOptions blas_options;
+  BvhBuildOptions tlas_options;
+  tlas_options.max_leaf_size = 1;  // traversal enters one instance per top-level leaf
+
+  // Bottom levels, built and permuted first; appended after the top level below.
+  std::vector<BvhNode> sphere_tree;
+  if (!scene.spheres.empty()) {
+    std::vector<BuildPrimitive> prims(scene.spheres.size());
+    for (size_t i = 0; i < prims.size(); ++i) prims[i] = sphere_primitive(scene.spheres[i]);
+    BvhTree tree;
+    try {
+      tree = build_bvh(prims, blas_options);
+    } catch (const std::length_error& e) {
+      throw SceneError(scene.source + ": /spheres: " + e.what());
+    }
+    permute_range(scene.spheres, 0, tree.order);
+    permute_range(scene.sphere_material, 0, tree.order);
+    scene.sphere_bvh = bvh_stats(tree.nodes, blas_options);
+    sphere_tree = std::move(tree.nodes);
+  }
+  std::vector<std::vector<BvhNode>> mesh_trees(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    SceneMesh& mesh = scene.meshes[m];
+    std::vector<BuildPrimitive> prims(mesh.triangle_count);
+    for (uint32_t i = 0; i < mesh.triangle_count; ++i) {
+      prims[i] = triangle_primitive(scene.triangles[mesh.first_triangle + i]);
+    }
+    BvhTree tree;
+    try {
+      tree = build_bvh(prims, blas_options);
+    } catch (const std::length_error& e) {
+      throw SceneError(mesh.file + ": " + e.what());
+    }
+    permute_range(scene.triangles, mesh.first_triangle, tree.order);
+    permute_range(scene.triangle_shading, mesh.first_triangle, tree.order);
+    permute_range(scene.triangle_material, mesh.first_triangle, tree.order);
+    mesh.bvh = bvh_stats(tree.nodes, blas_options);
+    mesh_trees[m] = std::move(tree.nodes);
+  }
+
+  // The top level over the placements' world boxes.
+  std::vector<BuildPrimitive> boxes(scene.placements.size());
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    const Placement& p = scene.placements[i];
+    const auto& tree = p.mesh == kSpheres ? sphere_tree : mesh_trees[p.mesh];
+    boxes[i].box = world_box(node_box(tree[0]), p);
+    boxes[i].centroid = boxes[i].box.centre();
+  }
+  BvhTree top;
+  try {
+    top = build_bvh(boxes, tlas_options);
+  } catch (const std::length_error& e) {
+    throw SceneError(scene.source + ": /instances: " + e.what());
+  }
+  scene.top_level_bvh = bvh_stats(top.nodes, tlas_options);
+  scene.nodes = std::move(top.nodes);
+  const int32_t sphere_root = sphere_tree.empty() ? -1 : append_tree(scene.nodes, sphere_tree, 0);
+  std::vector<int32_t> mesh_roots(scene.meshes.size());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    mesh_roots[m] = append_tree(scene.nodes, mesh_trees[m], scene.meshes[m].first_triangle);
+  }
+  if (scene.nodes.size() > static_cast<size_t>(INT32_MAX)) {
+    throw SceneError(scene.source + ": too many BVH nodes for 32-bit indices");
+  }
+  scene.instances.resize(top.order.size());
+  for (size_t i = 0; i < top.order.size(); ++i) {
+    const Placement& p = scene.placements[top.order[i]];
+    Instance& in = scene.instances[i];
+    in.object_from_world = p.object_from_world;
+    in.world_from_object = p.world_from_object;
+    in.root = p.mesh == kSpheres ? sphere_root : mesh_roots[p.mesh];
+    in.kind = p.mesh == kSpheres ? PrimitiveKind::Sphere : PrimitiveKind::Triangle;
+    in.material = p.material;
+    in.identity = p.identity ? 1u : 0u;
+  }
+}
+
+size_t Scene::instanced_triangles() const {
+  size_t total = 0;
+  for (const Placement& p : placements) {
+    if (p.mesh != kSpheres) total += meshes[p.mesh].triangle_count;
+  }
+  return total;
+}
+
+namespace {
+template <class T>
+size_t bytes_of(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
+}  // namespace
+
+size_t Scene::device_bytes() const {
+  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(spheres) + bytes_of(sphere_material) +
+                 bytes_of(triangles) + bytes_of(triangle_shading) + bytes_of(triangle_material) + bytes_of(normals) +
+                 bytes_of(uvs) + bytes_of(materials) + bytes_of(textures);
+  for (const Image& im : images) total += bytes_of(im.texels);
+  return total;
+}
+
+}  // namespace wt

@@ -1,0 +1,179 @@
+// Scene files: meshes (files of triangles, read once) and instances (placements of
+// a mesh by a transform, with an optional material).
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <cmath>
+#include <future>
+#include <limits>
+
+#include "scene/mesh_load.hpp"
+#include "scene/scene_reader.hpp"
+
+namespace wt {
+
+namespace {
+
+Affine affine_of(const glm::dmat4& m) {
+  Affine a;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) a.m[4 * r + c] = static_cast<float>(m[c][r]);  // glm is column-major
+  }
+  return a;
+}
+
+}  // namespace
+
+void SceneReader::read_meshes(const json& list, const JsonPath& path) {
+  // Every file is read on a thread of its own; the scene takes them in file order,
+  // so the first bad one (in the scene file's order) is the one reported.
+  struct Spec {
+    std::string name, file;
+    int32_t material;
+  };
+  std::vector<Spec> specs;
+  for (size_t i = 0; i < list.size(); ++i) {
+    const JsonPath at = path / i;
+    const json& j = list[i];
+    object(j, at);
+    check_keys(j, at, {"name", "file", "material"});
+    remember(mesh_names_, name(j, at), i, "mesh", at);
+    Spec s;
+    s.name = j["name"].get_ref<const std::string&>();
+    s.file = (base_dir_ / string(required(j, at, "file"), at / "file")).lexically_normal().string();
+    s.material = j.contains("material") ? material_named(j["material"], at / "material") : -1;
+    specs.push_back(std::move(s));
+  }
+  const auto start = Clock::now();
+  std::vector<std::future<TriangleMesh>> loading;
+  for (const Spec& s : specs) loading.push_back(std::async(std::launch::async, load_mesh, s.file));
+  std::vector<TriangleMesh> meshes;
+  for (auto& f : loading) f.wait();
+  for (auto& f : loading) meshes.push_back(f.get());
+  mesh_seconds_ += seconds_since(start);
+  for (size_t i = 0; i < meshes.size(); ++i) add_mesh(meshes[i], specs[i].name, specs[i].material);
+}
+
+void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override) {
+  const size_t total = scene_.triangles.size() + mesh.triangles.size();
+  if (total > static_cast<size_t>(std::numeric_limits<int32_t>::max()) ||
+      scene_.normals.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max()) {
+    throw SceneError(mesh.source + ": the scene's meshes hold more than 2^31 - 1 triangles");
+  }
+  // The file's materials join the scene's, named "<mesh>/<material>", unless overridden.
+  std::vector<uint32_t> material_of(mesh.materials.size());
+  if (material_override < 0) {
+    for (size_t i = 0; i < mesh.materials.size(); ++i) {
+      const MeshMaterial& mm = mesh.materials[i];
+      Material m = mm.material;
+      if (!mm.albedo_map.empty()) {
+        Texture t{};
+        t.kind = TextureKind::Image;
+        t.image = image_file(mm.albedo_map, true, mesh.source);
+        m.texture = static_cast<int32_t>(scene_.textures.size());
+        m.sort_key = material_sort_key(m.kind, static_cast<int>(TextureKind::Image));
+        scene_.textures.push_back(t);
+      }
+      material_of[i] = static_cast<uint32_t>(scene_.materials.size());
+      scene_.materials.push_back(m);
+      scene_.material_names.push_back(name + "/" + mm.name);
+    }
+  }
+  SceneMesh sm;
+  sm.name = name;
+  sm.file = mesh.source;
+  sm.first_triangle = static_cast<uint32_t>(scene_.triangles.size());
+  sm.triangle_count = static_cast<uint32_t>(mesh.triangles.size());
+  sm.dropped_degenerate = mesh.dropped_degenerate;
+  sm.dropped_nan = mesh.dropped_nan;
+  // Normals and UVs are stored per vertex where the mesh has them; a triangle's
+  // indices point into whichever the mesh has (both arrays grow alike).
+  const bool normals = !mesh.normals.empty(), uvs = !mesh.uvs.empty();
+  const uint32_t base = static_cast<uint32_t>(scene_.normals.size());
+  if (normals || uvs) {
+    for (size_t v = 0; v < mesh.positions.size(); ++v) {
+      scene_.normals.push_back(normals ? mesh.normals[v] : vec3(0.0f));
+      scene_.uvs.push_back(uvs ? mesh.uvs[v] : vec2(0.0f));
+    }
+  }
+  const uint32_t flags = (normals ? kTriangleHasNormals : 0u) | (uvs ? kTriangleHasUvs : 0u);
+  scene_.triangles.reserve(total);
+  scene_.triangle_shading.reserve(total);
+  scene_.triangle_material.reserve(total);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const auto& v = mesh.triangles[t];
+    TriangleGeom g{};
+    for (int c = 0; c < 3; ++c) {
+      const vec3& p = mesh.positions[v[c]];
+      float* dst = c == 0 ? g.p0 : (c == 1 ? g.p1 : g.p2);
+      dst[0] = p.x;
+      dst[1] = p.y;
+      dst[2] = p.z;
+    }
+    scene_.triangles.push_back(g);
+    TriangleShading sh{};
+    for (int c = 0; c < 3; ++c) sh.vertex[c] = flags ? base + v[c] : 0u;
+    sh.flags = flags;
+    scene_.triangle_shading.push_back(sh);
+    scene_.triangle_material.push_back(material_override >= 0 ? static_cast<uint32_t>(material_override)
+                                                              : material_of[mesh.triangle_material[t]]);
+  }
+  scene_.meshes.push_back(std::move(sm));
+}
+
+void SceneReader::read_instance(const json& j, const JsonPath& path) {
+  object(j, path);
+  check_keys(j, path, {"mesh", "material", "translate", "rotate", "scale", "matrix"});
+  const std::string& mesh = string(required(j, path, "mesh"), path / "mesh");
+  auto found = mesh_names_.find(mesh);
+  if (found == mesh_names_.end()) fail_at(path / "mesh", "unknown mesh '" + mesh + "'");
+  Placement p;
+  p.mesh = static_cast<int32_t>(found->second.first);
+  p.material = j.contains("material") ? material_named(j["material"], path / "material") : -1;
+
+  glm::dmat4 m(1.0);
+  if (j.contains("matrix")) {
+    for (const char* other : {"translate", "rotate", "scale"}) {
+      if (j.contains(other)) fail_at(path / other, "cannot be given with 'matrix'");
+    }
+    const JsonPath at = path / "matrix";
+    const json& rows = array(j["matrix"], at);
+    if (rows.size() != 16) fail_at(at, "must be an array of 16 numbers (got " + std::to_string(rows.size()) + ")");
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) m[c][r] = number(rows[4 * r + c], at / (4 * r + c));
+    }
+    if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0) {
+      fail_at(at, "the last row must be 0 0 0 1 (an affine transform)");
+    }
+  } else {
+    if (j.contains("translate")) m = glm::translate(m, glm::dvec3(triple(j["translate"], path / "translate")));
+    if (j.contains("rotate")) {
+      const vec3 degrees = triple(j["rotate"], path / "rotate");
+      m = glm::rotate(m, glm::radians(double(degrees.z)), glm::dvec3(0, 0, 1));
+      m = glm::rotate(m, glm::radians(double(degrees.y)), glm::dvec3(0, 1, 0));
+      m = glm::rotate(m, glm::radians(double(degrees.x)), glm::dvec3(1, 0, 0));
+    }
+    if (j.contains("scale")) {
+      const JsonPath at = path / "scale";
+      glm::dvec3 s = j["scale"].is_number() ? glm::dvec3(number(j["scale"], at)) : glm::dvec3(triple(j["scale"], at));
+      if (s.x == 0.0 || s.y == 0.0 || s.z == 0.0) fail_at(at, "must not be zero");
+      m = glm::scale(m, s);
+    }
+  }
+  const double det = glm::determinant(glm::dmat3(m));
+  if (!std::isfinite(det) || std::fabs(det) < 1e-18) {
+    fail_at(path, "the transform is singular (determinant " + std::to_string(det) + ")");
+  }
+  p.identity = m == glm::dmat4(1.0);
+  p.world_from_object = affine_of(m);
+  p.object_from_world = affine_of(glm::inverse(m));
+  scene_.placements.push_back(p);
+}
+
+int32_t SceneReader::material_named(const json& j, const JsonPath& path) const {
+  const std::string& m = string(j, path);
+  auto found = material_names_.find(m);
+  if (found == material_names_.end()) fail_at(path, "unknown material '" + m + "'");
+  return static_cast<int32_t>(found->second.first);
+}
+
+}  // namespace wt
