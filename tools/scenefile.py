@@ -33,7 +33,9 @@ def dumps_scene(scene):
     """JSON text with one list entry per line: diffs stay readable."""
     parts = []
     for key, value in scene.items():
-        if isinstance(value, list):
+        if isinstance(value, list) and not value:
+            parts.append("  %s: []" % json.dumps(key))
+        elif isinstance(value, list):
             body = ",\n".join("    " + json.dumps(v) for v in value)
             parts.append("  %s: [\n%s\n  ]" % (json.dumps(key), body))
         else:
