@@ -25,9 +25,13 @@ Scene built(const std::vector<SphereGeom>& spheres) {
   s.spheres = spheres;
   s.sphere_material.resize(spheres.size());
   std::iota(s.sphere_material.begin(), s.sphere_material.end(), 0u);
+  if (!spheres.empty()) s.placements.push_back({kSpheres, kIdentityTransform, kIdentityTransform, true, -1});
   build_bvh(s);
   return s;
 }
+
+// The root of the spheres' own tree (below the top level's single leaf).
+int sphere_root(const Scene& s) { return s.instances.at(0).root; }
 
 std::vector<SphereGeom> random_spheres(uint32_t seed, int count) {
   std::mt19937 rng(seed);
@@ -76,13 +80,14 @@ std::vector<SphereSet> sphere_sets() {
 }
 
 Hit brute_force(const std::vector<SphereGeom>& spheres, const Ray& ray, float tmin, float tmax) {
-  Hit hit{tmax, -1};
+  Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   for (size_t i = 0; i < spheres.size(); ++i) {
     const SphereGeom& s = spheres[i];
     float t;
     if (intersect_sphere(ray, vec3(s.x, s.y, s.z), s.w, tmin, hit.t, t)) {
       hit.t = t;
-      hit.sphere = static_cast<int32_t>(i);
+      hit.instance = 0;
+      hit.prim = static_cast<int32_t>(i);
     }
   }
   return hit;
@@ -130,8 +135,8 @@ int depth_below(const std::vector<BvhNode>& nodes, int node) {
 
 // Calls visit(node, parent) for every node reachable from the root, depth first.
 template <class Visit>
-void walk(const std::vector<BvhNode>& nodes, Visit visit) {
-  std::vector<std::pair<int, int>> todo = {{0, -1}};
+void walk(const std::vector<BvhNode>& nodes, int root, Visit visit) {
+  std::vector<std::pair<int, int>> todo = {{root, -1}};
   while (!todo.empty()) {
     auto [node, parent] = todo.back();
     todo.pop_back();
@@ -161,12 +166,12 @@ TEST(Bvh, ClosestHitMatchesBruteForce) {
     SceneView view = host_view(scene, 64, 64, images);
     int hits = 0;
     for (const RayCase& rc : random_rays(++seed, set.spheres, 4000)) {
-      Hit expect = brute_force(set.spheres, rc.ray, kRayTMin, rc.tmax);
-      Hit got = intersect_closest(view, rc.ray, kRayTMin, rc.tmax);
-      ASSERT_EQ(got.sphere < 0, expect.sphere < 0);
-      if (expect.sphere < 0) continue;
+      Hit expect = brute_force(set.spheres, rc.ray, kSphereTMin, rc.tmax);
+      Hit got = intersect_closest(view, rc.ray, rc.tmax);
+      ASSERT_EQ(got.missed(), expect.missed());
+      if (expect.missed()) continue;
       ++hits;
-      ASSERT_EQ(scene.sphere_material[got.sphere], static_cast<uint32_t>(expect.sphere));
+      ASSERT_EQ(scene.sphere_material[got.prim], static_cast<uint32_t>(expect.prim));
       ASSERT_EQ(got.t, expect.t);
     }
     EXPECT_GT(hits, 400) << "too few rays hit for the comparison to mean much";
@@ -179,7 +184,7 @@ TEST(Bvh, EverySphereIsInExactlyOneLeafOfAtMostFour) {
     Scene scene = built(set.spheres);
     ASSERT_EQ(scene.spheres.size(), set.spheres.size());
     std::vector<int> seen(scene.spheres.size(), 0);
-    walk(scene.nodes, [&](int node, int) {
+    walk(scene.nodes, sphere_root(scene), [&](int node, int) {
       const BvhNode& n = scene.nodes[node];
       if (n.count == 0) return;
       EXPECT_LE(n.count, 4);
@@ -204,9 +209,10 @@ TEST(Bvh, EveryNodeIsReachedOnceWithChildrenAfterTheirParent) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
     std::vector<int> reached(scene.nodes.size(), 0);
-    walk(scene.nodes, [&](int node, int parent) {
+    reached[0] = 1;  // the top level's one leaf
+    walk(scene.nodes, sphere_root(scene), [&](int node, int parent) {
       ++reached[node];
-      EXPECT_GT(node, parent);
+      EXPECT_GT(node, parent);  // the top level's leaf (node 0) comes first too
     });
     for (size_t i = 0; i < reached.size(); ++i) EXPECT_EQ(reached[i], 1) << "node " << i;
   }
@@ -216,7 +222,7 @@ TEST(Bvh, NodeBoundsContainTheirChildrenAndSpheres) {
   for (const SphereSet& set : sphere_sets()) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
-    walk(scene.nodes, [&](int node, int parent) {
+    walk(scene.nodes, sphere_root(scene), [&](int node, int parent) {
       const BvhNode& n = scene.nodes[node];
       if (parent >= 0) {
         EXPECT_TRUE(box_contains(scene.nodes[parent], n.lo, n.hi)) << "node " << node;
@@ -236,26 +242,30 @@ TEST(Bvh, DepthStaysBelowTheTraversalStack) {
   for (const SphereSet& set : sets) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
-    EXPECT_LT(depth_below(scene.nodes, 0), kBvhStackSize);
+    EXPECT_LE(depth_below(scene.nodes, sphere_root(scene)), kMaxBvhDepth);
   }
 }
 
-TEST(Bvh, OneSphereSceneIsASingleLeaf) {
+TEST(Bvh, OneSphereSceneIsALeafUnderTheTopLevelsLeaf) {
   Scene scene = built({SphereGeom{1, 2, 3, 0.5f}});
-  ASSERT_EQ(scene.nodes.size(), 1u);
-  EXPECT_EQ(scene.nodes[0].count, 1);
+  ASSERT_EQ(scene.nodes.size(), 2u);
+  EXPECT_EQ(scene.nodes[0].count, 1);  // the one instance
   EXPECT_EQ(scene.nodes[0].left_or_first, 0);
+  EXPECT_EQ(scene.nodes[1].count, 1);  // the one sphere
+  EXPECT_EQ(scene.nodes[1].left_or_first, 0);
   std::vector<ImageView> images;
-  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(1, 2, 0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
-  EXPECT_EQ(h.sphere, 0);
+  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(1, 2, 0), vec3(0, 0, 1)}, kRayTMax);
+  EXPECT_EQ(h.instance, 0);
+  EXPECT_EQ(h.prim, 0);
   EXPECT_FLOAT_EQ(h.t, 2.5f);
 }
 
 TEST(Bvh, GroundSphereIsIsolatedBelowTheRoot) {
   Scene scene = built(ground_and_marbles(7));
-  ASSERT_EQ(scene.nodes[0].count, 0);
+  const BvhNode& root = scene.nodes[sphere_root(scene)];
+  ASSERT_EQ(root.count, 0);
   int ground_leaf = -1;
-  for (int child : {scene.nodes[0].left_or_first, scene.nodes[0].left_or_first + 1}) {
+  for (int child : {root.left_or_first, root.left_or_first + 1}) {
     const BvhNode& n = scene.nodes[child];
     if (n.count == 1 && scene.sphere_material[n.left_or_first] == 0) ground_leaf = child;
   }
@@ -266,8 +276,8 @@ TEST(Bvh, NoSpheresGiveAnEmptyTreeThatMissesEverything) {
   Scene scene = built({});
   EXPECT_TRUE(scene.nodes.empty());
   std::vector<ImageView> images;
-  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(0), vec3(0, 0, 1)}, kRayTMin, kRayTMax);
-  EXPECT_LT(h.sphere, 0);
+  Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(0), vec3(0, 0, 1)}, kRayTMax);
+  EXPECT_TRUE(h.missed());
 }
 
 }  // namespace

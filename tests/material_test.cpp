@@ -39,8 +39,12 @@ SurfacePoint top_hit(bool front) {
   SurfacePoint sp;
   sp.p = vec3(0.0f, 1.0f, 0.0f);
   sp.n = vec3(0.0f, 1.0f, 0.0f);
+  sp.ng = sp.n;
   sp.local = sp.p;
+  sp.uv = vec2(0.0f);
+  sp.has_uv = false;
   sp.front = front;
+  sp.offset = kSphereSurfaceOffset;
   return sp;
 }
 
@@ -50,11 +54,11 @@ vec3 at_angle(double deg, bool down) {
   return vec3(float(std::sin(deg * kDegToRad)), float((down ? -1.0 : 1.0) * std::cos(deg * kDegToRad)), 0.0f);
 }
 
-// The outgoing ray must start kSurfaceOffset from the hit along the normal, on the
-// side the ray goes to.
+// The outgoing ray must start the surface's offset from the hit along the normal,
+// on the side the ray goes to.
 void expect_spawned_on_its_side(const SurfacePoint& sp, const Ray& next) {
   float side = glm::dot(next.dir, sp.n) >= 0.0f ? 1.0f : -1.0f;
-  vec3 want = sp.p + side * kSurfaceOffset * sp.n;
+  vec3 want = sp.p + side * sp.offset * sp.n;
   EXPECT_NEAR(glm::length(next.origin - want), 0.0f, 1e-7f);
 }
 
@@ -283,12 +287,16 @@ TEST(Material, EmissiveDoesNotScatter) {
   EXPECT_FALSE(scatter(m, nullptr, nullptr, in, sp, Rng::at(1, 1, 1, 1), att, next));
 }
 
-TEST(Material, SpawnRayOffsetsAlongTheNormalToTheOutgoingSide) {
-  const vec3 p(1.0f, 2.0f, 3.0f), n = glm::normalize(vec3(1.0f, 1.0f, 0.0f));
-  Ray out = spawn_ray(p, n, glm::normalize(vec3(1.0f, 0.2f, 0.0f)));
-  EXPECT_NEAR(glm::length(out.origin - (p + kSurfaceOffset * n)), 0.0f, 1e-7f);
-  Ray in = spawn_ray(p, n, glm::normalize(vec3(-1.0f, 0.2f, 0.3f)));
-  EXPECT_NEAR(glm::length(in.origin - (p - kSurfaceOffset * n)), 0.0f, 1e-7f);
+TEST(Material, SpawnRayOffsetsAlongTheGeometricNormalToTheOutgoingSide) {
+  SurfacePoint sp = top_hit(true);
+  sp.p = vec3(1.0f, 2.0f, 3.0f);
+  sp.ng = glm::normalize(vec3(1.0f, 1.0f, 0.0f));
+  sp.n = vec3(0.0f, 1.0f, 0.0f);  // the shading normal does not place the ray
+  sp.offset = 0.25f;
+  Ray out = spawn_ray(sp, glm::normalize(vec3(1.0f, 0.2f, 0.0f)));
+  EXPECT_NEAR(glm::length(out.origin - (sp.p + 0.25f * sp.ng)), 0.0f, 1e-7f);
+  Ray in = spawn_ray(sp, glm::normalize(vec3(-1.0f, 0.2f, 0.3f)));
+  EXPECT_NEAR(glm::length(in.origin - (sp.p - 0.25f * sp.ng)), 0.0f, 1e-7f);
   EXPECT_EQ(in.dir, glm::normalize(vec3(-1.0f, 0.2f, 0.3f)));
 }
 
@@ -296,16 +304,17 @@ TEST(Material, SpawnRayOffsetsAlongTheNormalToTheOutgoingSide) {
 struct OneSphereScene {
   SphereGeom sphere{0.0f, 0.0f, 0.0f, 1.0f};
   uint32_t sphere_material = 0;
+  Instance instance{kIdentityTransform, kIdentityTransform, 0, PrimitiveKind::Sphere, -1, 1u};
   Material material;
   SceneView view{};
   explicit OneSphereScene(const Material& m) : material(m) {
+    view.instances = &instance;
     view.spheres = &sphere;
-    view.sphere_material = &sphere_material;
+    view.sphere_materials = &sphere_material;
     view.nodes = nullptr;  // shade_hit does not traverse
     view.materials = &material;
     view.textures = nullptr;
     view.images = nullptr;
-    view.sphere_count = 1;
     view.node_total = 0;
     view.sky = Sky{SkyKind::Uniform, vec3(0.0f), vec3(0.0f)};
   }
@@ -319,7 +328,7 @@ TEST(Material, ShadeHitEmitterAddsWeightedEmissionAndEnds) {
   OneSphereScene scene(m);
   Ray ray{vec3(0.0f, 0.0f, 5.0f), vec3(0.0f, 0.0f, -1.0f)};
   vec3 throughput(0.5f, 0.25f, 1.0f), radiance(0.1f, 0.0f, 0.0f);
-  EXPECT_FALSE(shade_hit(scene.view, params(100), Hit{4.0f, 0}, 0, 0, 0, ray, throughput, radiance));
+  EXPECT_FALSE(shade_hit(scene.view, params(100), Hit{4.0f, 0, 0, 0.0f, 0.0f}, 0, 0, 0, ray, throughput, radiance));
   EXPECT_EQ(radiance, vec3(0.1f + 2.0f, 0.5f, 1.0f));
 }
 
@@ -381,7 +390,7 @@ TEST(Material, ShadeHitWithoutRouletteNeverEndsADiffusePath) {
   for (int i = 0; i < 10000; ++i) {
     Ray ray{vec3(0.0f, 0.0f, 5.0f), vec3(0.0f, 0.0f, -1.0f)};
     vec3 t(1.0f), radiance(0.0f);
-    ASSERT_TRUE(shade_hit(scene.view, params(8), Hit{4.0f, 0}, uint32_t(i), 0, 3, ray, t, radiance));
+    ASSERT_TRUE(shade_hit(scene.view, params(8), Hit{4.0f, 0, 0, 0.0f, 0.0f}, uint32_t(i), 0, 3, ray, t, radiance));
     ASSERT_EQ(t, vec3(0.05f));
   }
 }

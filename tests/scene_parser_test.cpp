@@ -222,8 +222,9 @@ TEST(SceneParser, OmittedFieldsTakeTheDocumentedDefaults) {
   EXPECT_EQ(s.materials[1].albedo, vec3(1.0f));
   EXPECT_EQ(s.materials[2].albedo, vec3(1.0f));
   EXPECT_EQ(s.materials[2].fuzz, 0.0f);
-  ASSERT_EQ(s.nodes.size(), 1u);  // one sphere: the root is a leaf
+  ASSERT_EQ(s.nodes.size(), 2u);  // one sphere: the top level's leaf, over the spheres' leaf
   EXPECT_EQ(s.nodes[0].count, 1);
+  EXPECT_EQ(s.nodes[1].count, 1);
 }
 
 TEST(SceneParser, UniformSkyUsesItsRadianceEverywhere) {
@@ -293,7 +294,7 @@ TEST(SceneParser, RepeatedKeysAreRejected) {
 
 TEST(SceneParser, RequiredKeysMustBePresent) {
   json doc = base_scene();
-  for (const char* path : {"/camera", "/camera/look_at", "/materials", "/spheres", "/spheres/3/radius",
+  for (const char* path : {"/camera", "/camera/look_at", "/materials", "/spheres/3/radius",
                            "/spheres/0/material", "/materials/2/ior", "/materials/4/emission", "/materials/1/name",
                            "/textures/0/size", "/textures/1/high", "/sky/type"}) {
     expect_error(without(doc, path), path, "required key is missing");
@@ -412,8 +413,10 @@ TEST(SceneParser, RenderValuesOutsideTheirRangesAreRejected) {
   expect_error(with(doc, "/render/seed", 18446744073709551615u), "/render/seed", "(got 18446744073709551615)");
 }
 
-TEST(SceneParser, EmptySphereListIsRejected) {
-  expect_error(with(base_scene(), "/spheres", json::array()), "/spheres", "must contain at least one sphere");
+TEST(SceneParser, ASceneWithNoSpheresAndNoInstancesIsRejected) {
+  const char* problem = "it needs at least one sphere or one instance";
+  expect_error(with(base_scene(), "/spheres", json::array()), "/spheres", problem);
+  expect_error(without(base_scene(), "/spheres"), "/spheres", problem);
 }
 
 TEST(SceneParser, VfovMustLieStrictlyBetweenZeroAnd180) {
@@ -555,11 +558,12 @@ TEST(SceneParser, HostViewPointsIntoTheSceneWithTheRendersCamera) {
   // The render's size, not the scene file's defaults, shapes the camera.
   SceneView v = host_view(s, 160, 90, images);
   EXPECT_EQ(v.spheres, s.spheres.data());
-  EXPECT_EQ(v.sphere_material, s.sphere_material.data());
+  EXPECT_EQ(v.sphere_materials, s.sphere_material.data());
   EXPECT_EQ(v.nodes, s.nodes.data());
+  EXPECT_EQ(v.instances, s.instances.data());
   EXPECT_EQ(v.materials, s.materials.data());
   EXPECT_EQ(v.textures, s.textures.data());
-  EXPECT_EQ(v.sphere_count, 5);
+  EXPECT_EQ(s.spheres.size(), 5u);
   EXPECT_EQ(v.node_count(), static_cast<int>(s.nodes.size()));
   ASSERT_EQ(images.size(), 1u);
   EXPECT_EQ(v.images, images.data());

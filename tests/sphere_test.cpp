@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "wavetrace/sphere.hpp"
+#include "wavetrace/geometry/sphere.hpp"
 
 namespace wt {
 namespace {

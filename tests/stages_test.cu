@@ -246,7 +246,8 @@ TYPED_TEST(Stages, IntersectFindsClosestHitsAddsSkyForMissesAndCountsRays) {
   this->ex->launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, 0, kTotal, 8});
 
   const auto t = Side::download(w.hits.t, 4);
-  const auto sphere = Side::download(w.hits.sphere, 4);
+  const auto sphere = Side::download(w.hits.prim, 4);
+  const auto instance = Side::download(w.hits.instance, 4);
   const auto entries = Side::download(w.entries, 8);
   const auto image = Side::download(film, kPixels * 3);
   EXPECT_NEAR(t[0], 7.5f, 1e-5f);
@@ -255,7 +256,8 @@ TYPED_TEST(Stages, IntersectFindsClosestHitsAddsSkyForMissesAndCountsRays) {
   EXPECT_EQ(sphere[1], sphere_at(scene, vec3(0, 0, 0)));
   EXPECT_NEAR(t[2], 9.0f, 1e-5f);
   EXPECT_EQ(sphere[2], sphere_at(scene, vec3(5, 0, 0)));
-  EXPECT_EQ(sphere[3], -1);
+  EXPECT_EQ(instance[0], 0);
+  EXPECT_EQ(instance[3], -1);
   for (uint32_t i = 0; i < 3; ++i) {
     EXPECT_EQ(entry_slot(entries[i]), i);
     EXPECT_EQ(entry_key(entries[i]), scene.materials[scene.sphere_material[sphere[i]]].sort_key);
@@ -333,9 +335,11 @@ struct ShadeCase {
   SceneView view = host_view(scene, kParams.width, kParams.height, images);
   std::vector<PathState> rays = known_rays();
   std::vector<float> t = std::vector<float>(3);
-  std::vector<int32_t> sphere = std::vector<int32_t>(3);
+  std::vector<int32_t> instance = std::vector<int32_t>(3);
+  std::vector<int32_t> prim = std::vector<int32_t>(3);
+  std::vector<float> b1 = std::vector<float>(3), b2 = std::vector<float>(3);
   std::vector<float> film = std::vector<float>(kPixels * 3, 0.0f);
-  HitQueue hits{t.data(), sphere.data()};
+  HitQueue hits{t.data(), instance.data(), prim.data(), b1.data(), b2.data()};
   cpu::HostMemory memory{queue_bytes(3)};
   PathQueue q;
 
@@ -375,9 +379,9 @@ TEST(ShadeStage, EachMaterialScattersAsItsDefinitionSays) {
   EXPECT_NEAR(next[1].throughput.x, 0.5f * 0.8f, 1e-6f);
   EXPECT_NEAR(next[1].throughput.y, 0.25f * 0.2f, 1e-6f);
   // Mirror, hit from above at (5, 1, 0): straight back up, throughput x albedo,
-  // starting kSurfaceOffset above the surface.
+  // starting the sphere's offset above the surface.
   EXPECT_NEAR(next[2].ray.dir.y, 1.0f, 1e-6f);
-  EXPECT_NEAR(next[2].ray.origin.y, 1.0f + kSurfaceOffset, 1e-5f);
+  EXPECT_NEAR(next[2].ray.origin.y, 1.0f + kSphereSurfaceOffset, 1e-5f);
   EXPECT_NEAR(next[2].throughput.z, 1.0f * 0.7f, 1e-6f);
 }
 
@@ -397,7 +401,10 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   float* film = this->template array<float>(kPixels * 3);
   upload_slots<Side>(w.queue[0], sc.rays);
   Side::upload(w.hits.t, sc.t);
-  Side::upload(w.hits.sphere, sc.sphere);
+  Side::upload(w.hits.instance, sc.instance);
+  Side::upload(w.hits.prim, sc.prim);
+  Side::upload(w.hits.b1, sc.b1);
+  Side::upload(w.hits.b2, sc.b2);
   Side::upload(w.selected, std::vector<uint32_t>{pack_entry(0, 2), pack_entry(0, 0), pack_entry(0, 1)});
   this->ex->launch(stage::kShade, 3,
                    ShadeItem{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected, 0,

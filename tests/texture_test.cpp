@@ -17,8 +17,18 @@ const vec3 kOdd(0.1f, 0.2f, 0.3f);
 
 Texture checker(float size) { return Texture{TextureKind::Checker, -1, size, 0, kEven, kOdd}; }
 
+// A sphere's surface point: local position and normal, UVs from the normal.
+SurfacePoint sphere_point(const vec3& local, const vec3& n) {
+  SurfacePoint sp{};
+  sp.local = local;
+  sp.n = n;
+  sp.ng = n;
+  sp.has_uv = false;
+  return sp;
+}
+
 vec3 eval_at(const Texture& t, const vec3& local) {
-  return eval_texture(t, nullptr, local, glm::normalize(local + vec3(0.0f, 1e-3f, 0.0f)));
+  return eval_texture(t, nullptr, sphere_point(local, glm::normalize(local + vec3(0.0f, 1e-3f, 0.0f))));
 }
 
 TEST(Texture, CheckerFollowsTheParityOfFloorXPlusFloorZ) {
@@ -156,8 +166,8 @@ TEST(Texture, ImageTextureIsContinuousAcrossTheSeam) {
   Texture t{TextureKind::Image, 0, 1.0f, 0, vec3(0.0f), vec3(0.0f)};
   const ImageView images[] = {im.view};
   for (float y : {-0.5f, 0.0f, 0.3f}) {
-    vec3 a = eval_texture(t, images, vec3(0.0f), glm::normalize(vec3(-1.0f, y, 1e-4f)));
-    vec3 b = eval_texture(t, images, vec3(0.0f), glm::normalize(vec3(-1.0f, y, -1e-4f)));
+    vec3 a = eval_texture(t, images, sphere_point(vec3(0.0f), glm::normalize(vec3(-1.0f, y, 1e-4f))));
+    vec3 b = eval_texture(t, images, sphere_point(vec3(0.0f), glm::normalize(vec3(-1.0f, y, -1e-4f))));
     // d u = 2e-4 / 2pi turns = 1.3e-4 texels of a 4-wide image, times a texel-to-texel
     // step of at most 30 in blue.
     EXPECT_NEAR(a.x, b.x, 1e-3f) << y;

@@ -37,7 +37,9 @@ void SceneReader::read(const json& root) {
     const json& instances = array(root["instances"], path);
     for (size_t i = 0; i < instances.size(); ++i) read_instance(instances[i], path / i);
   }
-  if (scene_.placements.empty()) fail_at(top, "the scene has nothing to render: no spheres and no instances");
+  if (scene_.placements.empty()) {
+    fail_at(top / "spheres", "the scene has nothing to render: it needs at least one sphere or one instance");
+  }
 }
 
 const std::string& SceneReader::name(const json& obj, const JsonPath& path) const {
