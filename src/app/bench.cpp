@@ -198,6 +198,7 @@ int run_bench(const BenchOptions& options) {
         row["seconds_min"] = *std::min_element(seconds.begin(), seconds.end());
         row["seconds_max"] = *std::max_element(seconds.begin(), seconds.end());
         add_measurements(row, kept, med, scene.load_times);
+        row["geometry"] = geometry_json(scene.summary());
         for (const StageTime& st : kept.stages) {
           if (std::find(stages.begin(), stages.end(), st.name) == stages.end()) stages.push_back(st.name);
         }

@@ -90,8 +90,23 @@ RenderParams resolve_params(const Scene& scene, const Job& job) {
 }
 
 void print_load_times(const LoadTimes& t, double upload_seconds) {
-  std::fprintf(stderr, "load: parse %.3f s, validate %.3f s, texture load %.3f s, BVH build %.3f s, upload %.3f s\n",
-               t.parse, t.validate, t.texture_load, t.bvh_build, upload_seconds);
+  std::fprintf(stderr,
+               "load: parse %.3f s, validate %.3f s, texture load %.3f s, mesh load %.3f s, BVH build %.3f s, "
+               "upload %.3f s\n",
+               t.parse, t.validate, t.texture_load, t.mesh_load, t.bvh_build, upload_seconds);
+}
+
+void print_geometry(const Scene::Summary& g) {
+  std::fprintf(stderr, "geometry: %zu spheres, %zu triangles stored, %zu placed, %zu instances, %zu BVH nodes\n",
+               g.spheres, g.triangles, g.instanced_triangles, g.instances, g.bvh_nodes);
+  if (g.dropped_degenerate || g.dropped_nan) {
+    std::fprintf(stderr, "geometry: dropped %zu degenerate and %zu non-finite triangles\n", g.dropped_degenerate,
+                 g.dropped_nan);
+  }
+  for (const auto& m : g.meshes) {
+    std::fprintf(stderr, "mesh %s: %zu triangles, BVH %zu nodes, depth %d, SAH cost %.1f\n", m.name.c_str(),
+                 m.triangles, m.bvh.nodes, m.bvh.depth, m.bvh.sah_cost);
+  }
 }
 
 void print_profile(const RenderResult& r) {
@@ -134,6 +149,7 @@ JobOutcome run_job(const Job& job) {
     } joined{context};
     Scene scene = load_scene(job.scene);
     out.load_times = scene.load_times;
+    out.geometry = scene.summary();
     RenderOptions options;
     options.params = resolve_params(scene, job);
     options.kernel = parse_kernel(job.kernel);
@@ -205,6 +221,7 @@ JobOutcome run_job(const Job& job) {
     if (!checkpoint_path.empty()) std::filesystem::remove(checkpoint_path);
     if (job.profile) {
       print_load_times(out.load_times, out.result.upload_seconds);
+      print_geometry(out.geometry);
       print_profile(out.result);
     }
   } catch (const SceneError& e) {

@@ -46,6 +46,7 @@ struct JobOutcome {
   bool device_lost = false;
   RenderParams params{};
   LoadTimes load_times;
+  Scene::Summary geometry;
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
   std::string backend, kernel;
   RenderResult result;

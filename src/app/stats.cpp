@@ -17,6 +17,36 @@ nlohmann::json settings_json(const RenderParams& params) {
   return j;
 }
 
+namespace {
+nlohmann::json bvh_json(const BvhStats& b) {
+  return {{"nodes", b.nodes}, {"leaves", b.leaves}, {"depth", b.depth}, {"sah_cost", b.sah_cost}};
+}
+}  // namespace
+
+nlohmann::json geometry_json(const Scene::Summary& g) {
+  nlohmann::json j = {{"spheres", g.spheres},
+                      {"triangles", g.triangles},
+                      {"instanced_triangles", g.instanced_triangles},
+                      {"instances", g.instances},
+                      {"dropped_degenerate", g.dropped_degenerate},
+                      {"dropped_nan", g.dropped_nan},
+                      {"bvh_nodes", g.bvh_nodes},
+                      {"device_bytes", g.device_bytes},
+                      {"top_level_bvh", bvh_json(g.top_level_bvh)}};
+  if (g.spheres) j["sphere_bvh"] = bvh_json(g.sphere_bvh);
+  nlohmann::json meshes = nlohmann::json::array();
+  for (const auto& m : g.meshes) {
+    meshes.push_back({{"name", m.name},
+                      {"file", m.file},
+                      {"triangles", m.triangles},
+                      {"dropped_degenerate", m.dropped_degenerate},
+                      {"dropped_nan", m.dropped_nan},
+                      {"bvh", bvh_json(m.bvh)}});
+  }
+  j["meshes"] = meshes;
+  return j;
+}
+
 void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load) {
   j["rays"] = r.rays;
   j["paths"] = r.paths;
@@ -24,6 +54,7 @@ void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, 
   j["load_seconds"] = {{"parse", load.parse},
                        {"validate", load.validate},
                        {"texture_load", load.texture_load},
+                       {"mesh_load", load.mesh_load},
                        {"bvh_build", load.bvh_build},
                        {"upload", r.upload_seconds}};
   j["m_rays_per_s"] = seconds > 0 ? r.rays / seconds / 1e6 : 0.0;
@@ -52,6 +83,7 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   if (o.resumed_from_sample > 0) j["resumed_from_sample"] = o.resumed_from_sample;
   j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
   add_measurements(j, r, r.seconds, o.load_times);
+  j["geometry"] = geometry_json(o.geometry);
   return j;
 }
 

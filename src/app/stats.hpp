@@ -16,6 +16,9 @@ nlohmann::json settings_json(const RenderParams& params);
 // the stage times and live paths per bounce.
 void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load);
 
+// The scene's geometry: counts, dropped triangles, BVH shapes and costs.
+nlohmann::json geometry_json(const Scene::Summary& geometry);
+
 // The --stats file of one job.
 nlohmann::json stats_json(const Job& job, const JobOutcome& outcome);
 

@@ -99,11 +99,35 @@ struct Scene {
 
   // Triangles placed, counting each instance's: what the scene renders.
   size_t instanced_triangles() const;
+  // What the scene holds, for --stats and the benchmark.
+  struct Summary;
+  Summary summary() const;
   // What the scene's arrays and images take on the device.
   size_t device_bytes() const;
 
   // Number of low bits that hold every sort key the scene's materials use (at least 1).
   int sort_key_bits() const;
+};
+
+// The scene's geometry in numbers: counts, what the loader dropped, and each BVH's
+// shape and SAH cost.
+struct Scene::Summary {
+  size_t spheres = 0;
+  size_t triangles = 0;            // stored: each mesh once
+  size_t instanced_triangles = 0;  // placed: each instance's
+  size_t instances = 0;            // top-level entries (the spheres count as one)
+  size_t dropped_degenerate = 0;
+  size_t dropped_nan = 0;
+  size_t bvh_nodes = 0;  // all levels
+  size_t device_bytes = 0;
+  BvhStats top_level_bvh;
+  BvhStats sphere_bvh;
+  struct Mesh {
+    std::string name, file;
+    size_t triangles, dropped_degenerate, dropped_nan;
+    BvhStats bvh;
+  };
+  std::vector<Mesh> meshes;
 };
 
 // Reads, validates and prepares (BVH built, sort keys set) a scene file.

@@ -178,4 +178,22 @@ size_t Scene::device_bytes() const {
   return total;
 }
 
+Scene::Summary Scene::summary() const {
+  Summary s;
+  s.spheres = spheres.size();
+  s.triangles = triangles.size();
+  s.instanced_triangles = instanced_triangles();
+  s.instances = instances.size();
+  s.bvh_nodes = nodes.size();
+  s.device_bytes = device_bytes();
+  s.top_level_bvh = top_level_bvh;
+  s.sphere_bvh = sphere_bvh;
+  for (const SceneMesh& m : meshes) {
+    s.dropped_degenerate += m.dropped_degenerate;
+    s.dropped_nan += m.dropped_nan;
+    s.meshes.push_back({m.name, m.file, m.triangle_count, m.dropped_degenerate, m.dropped_nan, m.bvh});
+  }
+  return s;
+}
+
 }  // namespace wt
