@@ -8,9 +8,10 @@ namespace wt {
 
 constexpr float kRayTMax = 3.0e38f;
 
-template <class Scene>
+// Kinds: the primitive kinds the scene holds (geometry.hpp), or a superset.
+template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE Hit intersect_scene(const Scene& scene, const Ray& ray) {
-  return intersect_closest(scene, ray, kRayTMax);
+  return intersect_closest<Kinds>(scene, ray, kRayTMax);
 }
 
 // Camera ray of path (pixel, sample).
@@ -24,15 +25,15 @@ WT_HD WT_INLINE Ray primary_ray(const Scene& scene, const RenderParams& rp, uint
 
 // Shades a hit at `bounce`: adds what the surface emits, scatters, and plays
 // Russian roulette. On true the path goes on along `ray`, with `throughput` updated.
-template <class Scene>
+template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const Hit& hit, uint32_t pixel,
                                uint32_t sample, uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance) {
-  const Material& m = scene.material(material_index(scene, hit));
+  const Material& m = scene.material(material_index<Kinds>(scene, hit));
   if (m.kind == MaterialKind::Emissive) {
     radiance += throughput * m.emission;
     return false;
   }
-  const SurfacePoint sp = surface_at(scene, ray, hit);
+  const SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   vec3 attenuation;
   Ray next;
@@ -49,19 +50,19 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
 }
 
 // The radiance of path (pixel, sample); `rays` grows by every ray intersected.
-template <class Scene>
+template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample,
                                 uint32_t& rays) {
   Ray ray = primary_ray(scene, rp, pixel, sample);
   vec3 throughput(1.0f), radiance(0.0f);
   for (int bounce = 0; bounce < rp.depth; ++bounce) {
-    Hit hit = intersect_scene(scene, ray);
+    Hit hit = intersect_scene<Kinds>(scene, ray);
     ++rays;
     if (hit.missed()) {
       radiance += throughput * scene.sky.radiance(ray.dir);
       break;
     }
-    if (!shade_hit(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance)) break;
+    if (!shade_hit<Kinds>(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance)) break;
   }
   return radiance;
 }

@@ -35,6 +35,7 @@ struct SceneView {
   const Texture* textures;
   const ImageView* images;
   int32_t node_total;
+  uint32_t kinds;  // the primitive kinds present (geometry.hpp), for choosing a kernel
   Sky sky;
   Camera camera;
 

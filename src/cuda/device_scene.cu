@@ -58,6 +58,7 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   view_.textures = textures_.get();
   view_.images = images_.get();
   view_.node_total = static_cast<int32_t>(scene.nodes.size());
+  view_.kinds = scene.primitive_kinds();
   view_.sky = scene.sky;
   view_.camera = Camera::make(scene.camera, width, height);
 }

@@ -9,7 +9,7 @@ namespace wt::cuda {
 constexpr int kMegakernelBlockX = 16;
 constexpr int kMegakernelBlockY = 8;
 
-template <class Scene>
+template <uint32_t Kinds, class Scene>
 __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const RenderParams& rp, int first_sample,
                                                  int samples, float* film, unsigned long long* rays) {
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
@@ -19,7 +19,7 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
     const uint32_t pixel = static_cast<uint32_t>(y) * rp.width + x;
     vec3 sum(0.0f);
     for (int s = first_sample; s < first_sample + samples; ++s) {
-      sum += trace_path(scene, rp, pixel, static_cast<uint32_t>(s), count);
+      sum += trace_path<Kinds>(scene, rp, pixel, static_cast<uint32_t>(s), count);
     }
     float* f = film + 3 * static_cast<size_t>(pixel);
     f[0] += sum.x;

@@ -50,13 +50,15 @@ struct ConstantScene {
 };
 
 ConstantScene g_scene{};  // host copy of the accessor, filled by upload_constant_scene
+uint32_t g_kinds = kAllKinds;  // the uploaded scene's primitive kinds
 
 size_t align16(size_t n) { return (n + 15) & ~size_t(15); }
 
+template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
     megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, float* film,
                         unsigned long long* rays) {
-  megakernel_pixel(scene, rp, first_sample, samples, film, rays);
+  megakernel_pixel<Kinds>(scene, rp, first_sample, samples, film, rays);
 }
 
 }  // namespace
@@ -95,12 +97,17 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   cs.camera = device_view.camera;
   WT_CUDA(cudaMemcpyToSymbol(c_pool, pool.data(), pool.size()), "constant upload");
   g_scene = cs;
+  g_kinds = device_view.kinds;
 }
 
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
                                 unsigned long long* rays, cudaStream_t stream) {
-  megakernel_constant<<<megakernel_grid(rp), dim3(kMegakernelBlockX, kMegakernelBlockY), 0, stream>>>(
-      g_scene, rp, first_sample, samples, film, rays);
+  const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
+  if (g_kinds == kSpheresOnly) {
+    megakernel_constant<kSpheresOnly><<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
+  } else {
+    megakernel_constant<kAllKinds><<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
+  }
   WT_CUDA_LAUNCHED("megakernel_constant", "megakernel-constant");
 }
 

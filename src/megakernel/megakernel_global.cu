@@ -4,16 +4,21 @@
 
 namespace wt::cuda {
 
+template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
     megakernel_global(SceneView scene, RenderParams rp, int first_sample, int samples, float* film,
                       unsigned long long* rays) {
-  megakernel_pixel(scene, rp, first_sample, samples, film, rays);
+  megakernel_pixel<Kinds>(scene, rp, first_sample, samples, film, rays);
 }
 
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
                        unsigned long long* rays, cudaStream_t stream) {
-  megakernel_global<<<megakernel_grid(rp), dim3(kMegakernelBlockX, kMegakernelBlockY), 0, stream>>>(
-      scene, rp, first_sample, samples, film, rays);
+  const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
+  if (scene.kinds == kSpheresOnly) {
+    megakernel_global<kSpheresOnly><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
+  } else {
+    megakernel_global<kAllKinds><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
+  }
   WT_CUDA_LAUNCHED("megakernel_global", "megakernel");
 }
 

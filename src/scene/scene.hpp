@@ -102,6 +102,8 @@ struct Scene {
   // What the scene holds, for --stats and the benchmark.
   struct Summary;
   Summary summary() const;
+  // The primitive kinds the scene places (geometry.hpp's bits).
+  uint32_t primitive_kinds() const;
   // What the scene's arrays and images take on the device.
   size_t device_bytes() const;
 

@@ -178,6 +178,14 @@ size_t Scene::device_bytes() const {
   return total;
 }
 
+uint32_t Scene::primitive_kinds() const {
+  uint32_t kinds = 0;
+  for (const Placement& p : placements) {
+    kinds |= kind_bit(p.mesh == kSpheres ? PrimitiveKind::Sphere : PrimitiveKind::Triangle);
+  }
+  return kinds;
+}
+
 Scene::Summary Scene::summary() const {
   Summary s;
   s.spheres = spheres.size();

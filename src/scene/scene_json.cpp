@@ -155,6 +155,7 @@ SceneView host_view(const Scene& scene, int width, int height, std::vector<Image
   v.textures = scene.textures.data();
   v.images = image_views.data();
   v.node_total = static_cast<int32_t>(scene.nodes.size());
+  v.kinds = scene.primitive_kinds();
   v.sky = scene.sky;
   v.camera = Camera::make(scene.camera, width, height);
   return v;

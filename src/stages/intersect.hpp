@@ -12,11 +12,12 @@
 
 namespace wt {
 
-// Slot i's ray is `ray`; on a miss the path's index and throughput are read from the queue.
-template <class Scene>
+// Slot i's ray is `ray`; on a miss the path's index and throughput are read from the
+// queue. Kinds: the primitive kinds the scene holds (a superset gives the same hits).
+template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& scene, const RenderParams& rp,
                                        const PathQueue& q, const HitQueue& hits, float* film) {
-  Hit h = intersect_scene(scene, ray);
+  Hit h = intersect_scene<Kinds>(scene, ray);
   hits.store(i, h);
   if (h.missed()) {
     const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
@@ -24,7 +25,7 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
     accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir));
     return pack_entry(kSortKeyMiss, i);
   }
-  return pack_entry(scene.material(material_index(scene, h)).sort_key, i);
+  return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);
 }
 
 // Slot i's ray as the queue holds it.
@@ -35,6 +36,7 @@ WT_HD WT_INLINE Ray queued_ray(const PathQueue& q, uint32_t i) {
 // Over every slot of the wave: free slots start a path, then every live slot's ray
 // is traced. Slots past the live ones get a miss entry, so that compact, which runs
 // over the whole capacity without the host knowing the count, drops them.
+template <uint32_t Kinds>
 struct IntersectItem {
   SceneView scene;
   RenderParams rp;
@@ -63,7 +65,7 @@ struct IntersectItem {
     } else {
       ray = queued_ray(queue, i);
     }
-    entries[i] = intersect_one(i, ray, scene, rp, queue, hits, film);
+    entries[i] = intersect_one<Kinds>(i, ray, scene, rp, queue, hits, film);
   }
 };
 

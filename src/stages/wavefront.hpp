@@ -89,8 +89,15 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       const uint32_t first = static_cast<uint32_t>(pass.first);
       ex.zero(w.counters, sizeof(WaveCounters));
       for (int cur = 0;; cur = 1 - cur) {
-        ex.launch(stage::kIntersect, slots,
-                  IntersectItem{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, first, slots, film});
+        if (scene.kinds == kSpheresOnly) {
+          ex.launch(stage::kIntersect, slots,
+                    IntersectItem<kSpheresOnly>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total,
+                                                first, slots, film});
+        } else {
+          ex.launch(stage::kIntersect, slots,
+                    IntersectItem<kAllKinds>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total,
+                                             first, slots, film});
+        }
         ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
         ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,
                   w.temp_bytes);

@@ -18,8 +18,16 @@ namespace wt {
 // The stack entry that marks the return from an instance's BVH to the top level.
 constexpr int kReturnToWorld = -1;
 
+// Sets of primitive kinds, one bit each. A kernel compiled for the kinds a scene
+// holds carries no code, and no registers, for the others: the traversal's live
+// state for triangles would otherwise cost sphere-only scenes occupancy. Every
+// choice gives the same hits.
+constexpr uint32_t kind_bit(PrimitiveKind k) { return 1u << static_cast<uint32_t>(k); }
+constexpr uint32_t kSpheresOnly = kind_bit(PrimitiveKind::Sphere);
+constexpr uint32_t kAllKinds = kind_bit(PrimitiveKind::Sphere) | kind_bit(PrimitiveKind::Triangle);
+
 // Tests the `count` primitives from `first` of an instance of `kind`, narrowing `hit`.
-template <class Geometry>
+template <uint32_t Kinds, class Geometry>
 WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int instance, int first, int count,
                                     const Ray& ray, const TriangleRay& tr, Hit& hit) {
   for (int prim = first; prim < first + count; ++prim) {
@@ -32,7 +40,9 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
         break;
       }
       case PrimitiveKind::Triangle:
-        found = intersect_triangle(g.triangle(prim), ray.origin, tr, hit.t, t, b1, b2);
+        if (Kinds & kind_bit(PrimitiveKind::Triangle)) {
+          found = intersect_triangle(g.triangle(prim), ray.origin, tr, hit.t, t, b1, b2);
+        }
         break;
     }
     if (found) hit = Hit{t, instance, prim, b1, b2};
@@ -43,18 +53,22 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
 // instances; entering one moves the ray into the instance's object space (where t
 // measures the same distances: the direction is transformed, not renormalised) and
 // pushes the mark of the way back.
-template <class Geometry>
+template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   if (g.node_count() == 0) return hit;
-  const vec3 world_inv(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
+  // Only triangle instances are ever transformed (spheres stand untransformed).
+  constexpr bool kTransforms = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
   Ray ray = world;
-  vec3 inv = world_inv;
+  vec3 inv(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
   TriangleRay tr{};
   int instance = -1;
   PrimitiveKind kind = PrimitiveKind::Sphere;
-  int stack[kBvhStackSize];
-  float stack_t[kBvhStackSize];
+  // Spheres alone stand in one instance: the top level is a single leaf, and the
+  // stack holds the return mark and one tree's deferred nodes.
+  constexpr int kStack = kTransforms ? kBvhStackSize : kMaxBvhDepth + 1;
+  int stack[kStack];
+  float stack_t[kStack];
   int top = 0;
   int node = 0;
   for (;;) {
@@ -63,13 +77,13 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       instance = n.left_or_first;
       const Instance& in = g.instance(instance);
       kind = in.kind;
-      if (!in.identity) {
+      if (kTransforms && !in.identity) {
         ray.origin = in.object_from_world.point(world.origin);
         ray.dir = in.object_from_world.vector(world.dir);
         inv = vec3(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
       }
-      if (kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
-      if (top < kBvhStackSize) {
+      if ((Kinds & kind_bit(PrimitiveKind::Triangle)) && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
+      if (top < kStack) {
         stack[top] = kReturnToWorld;
         stack_t[top++] = 0.0f;
       }
@@ -77,7 +91,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       continue;
     }
     if (n.count > 0) {
-      intersect_leaf(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
+      intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
     } else {
       int a = n.left_or_first, b = n.left_or_first + 1;
       float ta = box_entry(g.node(a), ray.origin, inv, hit.t);
@@ -91,7 +105,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
         b = ti;
       }
       if (ta <= hit.t) {
-        if (tb <= hit.t && top < kBvhStackSize) {
+        if (tb <= hit.t && top < kStack) {
           stack[top] = b;
           stack_t[top++] = tb;
         }
@@ -104,9 +118,11 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
     while (top > 0) {
       --top;
       if (stack[top] == kReturnToWorld) {
+        if (kTransforms) {
+          ray = world;
+          inv = vec3(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
+        }
         instance = -1;
-        ray = world;
-        inv = world_inv;
         continue;
       }
       if (stack_t[top] <= hit.t) {
@@ -121,8 +137,9 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
 }
 
 // The material a hit shades with: the instance's override, or the primitive's own.
-template <class Geometry>
+template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD WT_INLINE uint32_t material_index(const Geometry& g, const Hit& hit) {
+  if (Kinds == kSpheresOnly) return g.sphere_material(hit.prim);  // spheres take no override
   const Instance& in = g.instance(hit.instance);
   if (in.material >= 0) return static_cast<uint32_t>(in.material);
   switch (in.kind) {
@@ -183,8 +200,9 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
 }
 
 // The surface at a hit of `ray` (in world space).
-template <class Geometry>
+template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD WT_INLINE SurfacePoint surface_at(const Geometry& g, const Ray& ray, const Hit& hit) {
+  if (Kinds == kSpheresOnly) return sphere_surface(g.sphere(hit.prim), ray, hit.t);
   const Instance& in = g.instance(hit.instance);
   switch (in.kind) {
     case PrimitiveKind::Sphere:
