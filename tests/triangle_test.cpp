@@ -140,6 +140,29 @@ TEST(Triangle, HitBeyondTmaxMisses) {
   EXPECT_TRUE(shoot(g, o, vec3(0, 0, 2), 2.51f).hit);
 }
 
+// A ray that grazes a small triangle (0.17 degrees off its plane) through its
+// middle: in double the hit is at t = 2.6595607 with weights (0.3256, 0.2168),
+// far from every edge. The values are a triangle of the Stanford bunny and a ray
+// carried into its object space by an instance that scales by 12.85 (so the
+// direction has length 0.078), as MeshBvh.RealMeshMatchesBruteForce met them. The
+// hit must be found whatever the direction's length: t scales inversely with it.
+TEST(Triangle, GrazingHitWellInsideIsFoundWhateverTheDirectionsLength) {
+  const TriangleGeom g = tri(vec3(-0.0263139997f, 0.182659f, -0.0105579998f),
+                             vec3(-0.0272799991f, 0.181916997f, -0.0121060004f),
+                             vec3(-0.0281160008f, 0.181397006f, -0.0109689999f));
+  const vec3 o(-0.0996553227f, 0.123702846f, -0.196019873f);
+  const vec3 d(0.0273113362f, 0.0219739247f, 0.0695110187f);
+  const float len = glm::length(d);
+  for (float k : {1.0f, 1.0f / len, 10.0f / len}) {
+    SCOPED_TRACE("direction of length " + std::to_string(k * len));
+    const TriHit h = shoot(g, o, k * d);
+    ASSERT_TRUE(h.hit);
+    EXPECT_NEAR(h.t * k, 2.6595607, 1e-4 * 2.6595607);
+    EXPECT_NEAR(h.b1, 0.325579, 1e-3);
+    EXPECT_NEAR(h.b2, 0.216791, 1e-3);
+  }
+}
+
 // ---- (b) watertightness through the scene's traversal ----
 
 struct MeshScene {
