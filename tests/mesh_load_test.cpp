@@ -402,7 +402,7 @@ TEST_F(MeshLoad, GltfErrorsNameTheFileAndTheProblem) {
 
 // ---- The real models of ../shared/models ----
 
-std::filesystem::path models() { return std::filesystem::path(test::repo_root()) / ".." / "shared" / "models"; }
+std::filesystem::path models() { return test::models_dir(); }
 
 void expect_model(const char* file, size_t triangles, bool uvs) {
   std::filesystem::path path = models() / file;

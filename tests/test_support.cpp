@@ -26,6 +26,11 @@ std::string repo_root() {
 
 std::string repo_path(const std::string& relative) { return repo_root() + "/" + relative; }
 
+std::string models_dir() {
+  if (const char* env = std::getenv("WAVETRACE_MODELS")) return env;
+  return (std::filesystem::path(repo_root()) / ".." / "shared" / "models").lexically_normal().string();
+}
+
 TestFolder::TestFolder() {
   const testing::TestInfo* test = testing::UnitTest::GetInstance()->current_test_info();
   std::string name = std::string("wavetrace_") + test->test_suite_name() + "_" + test->name() + "_" +

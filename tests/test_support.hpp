@@ -32,6 +32,11 @@ std::string repo_root();
 // Path of a file under the repository root.
 std::string repo_path(const std::string& relative);
 
+// The shared real meshes (stanford-bunny.obj, teapot.obj, ...): WAVETRACE_MODELS
+// where set (a machine whose copy of the tree has them elsewhere), else
+// ../shared/models beside the repository root. Tests that use them skip without them.
+std::string models_dir();
+
 bool cuda_available();
 
 // Whether this binary was built with AddressSanitizer (scripts/test-asan.sh): its
