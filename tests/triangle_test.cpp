@@ -158,8 +158,11 @@ TEST(Triangle, GrazingHitWellInsideIsFoundWhateverTheDirectionsLength) {
     const TriHit h = shoot(g, o, k * d);
     ASSERT_TRUE(h.hit);
     EXPECT_NEAR(h.t * k, 2.6595607, 1e-4 * 2.6595607);
-    EXPECT_NEAR(h.b1, 0.325579, 1e-3);
-    EXPECT_NEAR(h.b2, 0.216791, 1e-3);
+    // The weights of a grazing hit are ill-conditioned: float rounding of corners
+    // 90 triangle-sizes from the origin, amplified by 1 / sin(0.17 degrees) = 340,
+    // moves them by up to about 3e-3.
+    EXPECT_NEAR(h.b1, 0.325579, 5e-3);
+    EXPECT_NEAR(h.b2, 0.216791, 5e-3);
   }
 }
 

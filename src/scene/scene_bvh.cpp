@@ -22,11 +22,17 @@ BuildPrimitive sphere_primitive(const SphereGeom& s) {
   return p;
 }
 
-// Triangles: the corners' box is exact, and the slab test rounds its far side up.
+// Triangles: the corners' box, an ulp wider on every side, so that no triangle lies
+// in the plane of a box face (geometry/bvh.hpp, slab_inverse); the slab test rounds
+// its far side up for the rest.
 BuildPrimitive triangle_primitive(const TriangleGeom& t) {
   BuildPrimitive p;
   for (int i = 0; i < 3; ++i) p.box.grow(t.corner(i));
   p.centroid = p.box.centre();
+  for (int k = 0; k < 3; ++k) {
+    p.box.lo[k] = std::nextafter(p.box.lo[k], -FLT_MAX);
+    p.box.hi[k] = std::nextafter(p.box.hi[k], FLT_MAX);
+  }
   return p;
 }
 

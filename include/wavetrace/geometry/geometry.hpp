@@ -60,7 +60,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   // Only triangle instances are ever transformed (spheres stand untransformed).
   constexpr bool kTransforms = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
   Ray ray = world;
-  vec3 inv(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
+  vec3 inv = slab_inverse(world.dir);
   TriangleRay tr{};
   int instance = -1;
   PrimitiveKind kind = PrimitiveKind::Sphere;
@@ -80,7 +80,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       if (kTransforms && !in.identity) {
         ray.origin = in.object_from_world.point(world.origin);
         ray.dir = in.object_from_world.vector(world.dir);
-        inv = vec3(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
+        inv = slab_inverse(ray.dir);
       }
       if ((Kinds & kind_bit(PrimitiveKind::Triangle)) && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
       if (top < kStack) {
@@ -94,8 +94,8 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
     } else {
       int a = n.left_or_first, b = n.left_or_first + 1;
-      float ta = box_entry(g.node(a), ray.origin, inv, hit.t);
-      float tb = box_entry(g.node(b), ray.origin, inv, hit.t);
+      float ta = box_entry<kTransforms>(g.node(a), ray.origin, inv, hit.t);
+      float tb = box_entry<kTransforms>(g.node(b), ray.origin, inv, hit.t);
       if (ta > tb) {
         float tt = ta;
         ta = tb;
@@ -120,7 +120,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       if (stack[top] == kReturnToWorld) {
         if (kTransforms) {
           ray = world;
-          inv = vec3(1.0f / world.dir.x, 1.0f / world.dir.y, 1.0f / world.dir.z);
+          inv = slab_inverse(world.dir);
         }
         instance = -1;
         continue;

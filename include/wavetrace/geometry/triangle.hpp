@@ -83,6 +83,8 @@ WT_HD WT_INLINE bool intersect_triangle(const TriangleGeom& tri, const vec3& o, 
                                         float& t_out, float& b1_out, float& b2_out) {
   vec3 a = tri.corner(0) - o, b = tri.corner(1) - o, c = tri.corner(2) - o;
   float az = component(a, tr.kz), bz = component(b, tr.kz), cz = component(c, tr.kz);
+  // The largest unscaled z: the shear's error is in the same units as x and y.
+  const float max_z_space = fmaxf(fabsf(az), fmaxf(fabsf(bz), fabsf(cz)));
   float ax = component(a, tr.kx) + tr.sx * az, ay = component(a, tr.ky) + tr.sy * az;
   float bx = component(b, tr.kx) + tr.sx * bz, by = component(b, tr.ky) + tr.sy * bz;
   float cx = component(c, tr.kx) + tr.sx * cz, cy = component(c, tr.ky) + tr.sy * cz;
@@ -101,13 +103,16 @@ WT_HD WT_INLINE bool intersect_triangle(const TriangleGeom& tri, const vec3& o, 
   }
   float inv_det = 1.0f / det;
   float t = t_scaled * inv_det;
-  // A conservative bound on t's error: the hit must lie beyond it.
+  // A conservative bound on t's error: the hit must lie beyond it. The sheared x and
+  // y carry the error of x + s z with |s| <= 1 (z is the dominant axis), in space
+  // units; the scaled z is in units of t. Mixing the two would make the bound
+  // depend on the direction's length, which instances change.
   float max_z = fmaxf(fabsf(az), fmaxf(fabsf(bz), fabsf(cz)));
   float max_x = fmaxf(fabsf(ax), fmaxf(fabsf(bx), fabsf(cx)));
   float max_y = fmaxf(fabsf(ay), fmaxf(fabsf(by), fabsf(cy)));
   float delta_z = rounding_gamma(3) * max_z;
-  float delta_x = rounding_gamma(5) * (max_x + max_z);
-  float delta_y = rounding_gamma(5) * (max_y + max_z);
+  float delta_x = rounding_gamma(5) * (max_x + max_z_space);
+  float delta_y = rounding_gamma(5) * (max_y + max_z_space);
   float delta_e = 2.0f * (rounding_gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
   float max_e = fmaxf(fabsf(e0), fmaxf(fabsf(e1), fabsf(e2)));
   float delta_t =
