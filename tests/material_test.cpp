@@ -349,7 +349,7 @@ TEST(Material, ShadeHitRussianRouletteIsUnbiased) {
                   Case{vec3(3.0f, 1.0f, 0.5f), vec3(0.7f, 0.7f, 0.7f)}}) {  // p capped at 0.95
     OneSphereScene scene(make_material(MaterialKind::Lambertian, cs.albedo));
     const Ray start{vec3(0.0f, 0.0f, 5.0f), vec3(0.0f, 0.0f, -1.0f)};
-    const Hit hit{4.0f, 0};
+    const Hit hit{4.0f, 0, 0, 0.0f, 0.0f};
 
     vec3 expected = cs.throughput_in;
     {

@@ -407,7 +407,7 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   Side::upload(w.hits.b2, sc.b2);
   Side::upload(w.selected, std::vector<uint32_t>{pack_entry(0, 2), pack_entry(0, 0), pack_entry(0, 1)});
   this->ex->launch(stage::kShade, 3,
-                   ShadeItem{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected, 0,
+                   ShadeItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected, 0,
                              film});
   ASSERT_EQ(Side::download(&w.counters->queued[1], 1)[0], 3u);
   std::map<uint32_t, PathState> pushed;

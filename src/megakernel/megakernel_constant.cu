@@ -103,11 +103,10 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
                                 unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
-  if (g_kinds == kSpheresOnly) {
-    megakernel_constant<kSpheresOnly><<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
-  } else {
-    megakernel_constant<kAllKinds><<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
-  }
+  with_kinds(g_kinds, [&](auto kinds) {
+    megakernel_constant<decltype(kinds)::value>
+        <<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
+  });
   WT_CUDA_LAUNCHED("megakernel_constant", "megakernel-constant");
 }
 

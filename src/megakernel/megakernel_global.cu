@@ -14,11 +14,9 @@ __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
                        unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
-  if (scene.kinds == kSpheresOnly) {
-    megakernel_global<kSpheresOnly><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
-  } else {
-    megakernel_global<kAllKinds><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
-  }
+  with_kinds(scene.kinds, [&](auto kinds) {
+    megakernel_global<decltype(kinds)::value><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
+  });
   WT_CUDA_LAUNCHED("megakernel_global", "megakernel");
 }
 

@@ -197,12 +197,7 @@ BvhTree build_bvh(const std::vector<BuildPrimitive>& prims, const BvhBuildOption
 BvhStats bvh_stats(const std::vector<BvhNode>& nodes, const BvhBuildOptions& options) {
   BvhStats stats;
   if (nodes.empty()) return stats;
-  auto area = [](const BvhNode& n) {
-    Aabb b;
-    b.lo = vec3(n.lo[0], n.lo[1], n.lo[2]);
-    b.hi = vec3(n.hi[0], n.hi[1], n.hi[2]);
-    return b.area();
-  };
+  auto area = [](const BvhNode& n) { return node_bounds(n).area(); };
   const double root_area = area(nodes[0]);
   std::vector<std::pair<int, int>> todo{{0, 1}};  // (node, depth)
   while (!todo.empty()) {

@@ -31,6 +31,13 @@ struct Aabb {
   }
 };
 
+inline Aabb node_bounds(const BvhNode& n) {
+  Aabb b;
+  b.lo = vec3(n.lo[0], n.lo[1], n.lo[2]);
+  b.hi = vec3(n.hi[0], n.hi[1], n.hi[2]);
+  return b;
+}
+
 struct BvhBuildOptions {
   int max_leaf_size = 4;
   // The cost of visiting an inner node relative to one primitive test.

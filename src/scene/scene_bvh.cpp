@@ -54,13 +54,6 @@ int32_t append_tree(std::vector<BvhNode>& nodes, const std::vector<BvhNode>& tre
   return base;
 }
 
-Aabb node_box(const BvhNode& n) {
-  Aabb b;
-  b.lo = vec3(n.lo[0], n.lo[1], n.lo[2]);
-  b.hi = vec3(n.hi[0], n.hi[1], n.hi[2]);
-  return b;
-}
-
 // The world box of an instance: its tree's root box through the transform, widened
 // by the rounding of the transform (rays are carried the other way, into object
 // space, and must not be culled here where they hit there).
@@ -129,7 +122,7 @@ void build_bvh(Scene& scene) {
   for (size_t i = 0; i < boxes.size(); ++i) {
     const Placement& p = scene.placements[i];
     const auto& tree = p.mesh == kSpheres ? sphere_tree : mesh_trees[p.mesh];
-    boxes[i].box = world_box(node_box(tree[0]), p);
+    boxes[i].box = world_box(node_bounds(tree[0]), p);
     boxes[i].centroid = boxes[i].box.centre();
   }
   BvhTree top;

@@ -36,9 +36,9 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     const json& j = list[i];
     object(j, at);
     check_keys(j, at, {"name", "file", "material"});
-    remember(mesh_names_, name(j, at), i, "mesh", at);
     Spec s;
-    s.name = j["name"].get_ref<const std::string&>();
+    s.name = name(j, at);
+    remember(mesh_names_, s.name, i, "mesh", at);
     s.file = (base_dir_ / string(required(j, at, "file"), at / "file")).lexically_normal().string();
     s.material = j.contains("material") ? material_named(j["material"], at / "material") : -1;
     specs.push_back(std::move(s));
@@ -47,7 +47,6 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   std::vector<std::future<TriangleMesh>> loading;
   for (const Spec& s : specs) loading.push_back(std::async(std::launch::async, load_mesh, s.file));
   std::vector<TriangleMesh> meshes;
-  for (auto& f : loading) f.wait();
   for (auto& f : loading) meshes.push_back(f.get());
   mesh_seconds_ += seconds_since(start);
   for (size_t i = 0; i < meshes.size(); ++i) add_mesh(meshes[i], specs[i].name, specs[i].material);

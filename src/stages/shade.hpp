@@ -12,14 +12,15 @@ namespace wt {
 
 // Scatters the path in slot `slot` (of the pass whose first sample is
 // `first_sample`); on true `next` is the path's next bounce.
-template <class Scene>
+// Kinds: the primitive kinds the scene holds (a superset shades the same).
+template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene& scene, const RenderParams& rp,
                                const PathQueue& q, const HitQueue& hits, float* film, PathState& next) {
   PathState s = q.load(slot);
   const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
   const uint32_t pixel = s.path % pixels;
   vec3 radiance(0.0f);
-  bool alive = shade_hit(scene, rp, hits.load(slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
+  bool alive = shade_hit<Kinds>(scene, rp, hits.load(slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
                          s.throughput, radiance);
   if (radiance.x != 0.0f || radiance.y != 0.0f || radiance.z != 0.0f) accumulate_one(film, pixel, radiance);
   s.bounce += 1;
@@ -28,6 +29,7 @@ WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene
 }
 
 // Over the `count` entries of `list`.
+template <uint32_t Kinds>
 struct ShadeItem {
   SceneView scene;
   RenderParams rp;
@@ -41,7 +43,7 @@ struct ShadeItem {
 
   WT_HD void operator()(uint32_t i) const {
     PathState next;
-    const bool alive = shade_one(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next);
+    const bool alive = shade_one<Kinds>(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next);
     // Every item reaches the push, so that a warp reserves its slots with one atomic.
     const uint32_t slot = push_slot(next_count, alive);
     if (alive) next_queue.store(slot, next);

@@ -89,15 +89,11 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       const uint32_t first = static_cast<uint32_t>(pass.first);
       ex.zero(w.counters, sizeof(WaveCounters));
       for (int cur = 0;; cur = 1 - cur) {
-        if (scene.kinds == kSpheresOnly) {
+        with_kinds(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
-                    IntersectItem<kSpheresOnly>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total,
-                                                first, slots, film});
-        } else {
-          ex.launch(stage::kIntersect, slots,
-                    IntersectItem<kAllKinds>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total,
-                                             first, slots, film});
-        }
+                    IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, first,
+                                           slots, film});
+        });
         ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
         ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,
                   w.temp_bytes);
@@ -108,9 +104,11 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         if (sorted && c.hits > 0) {
           list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
         }
-        ex.launch(stage::kShade, c.hits,
-                  ShadeItem{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], list,
-                            first, film});
+        with_kinds(scene.kinds, [&](auto kinds) {
+          ex.launch(stage::kShade, c.hits,
+                    ShadeItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur],
+                                                      &w.counters->queued[1 - cur], list, first, film});
+        });
         if (last && options.progress) {
           options.progress(static_cast<double>(paths_done + c.next_path - c.queued[cur]) / all_paths, rays + c.rays,
                            ex.elapsed_host());

@@ -8,6 +8,8 @@
 // triangle_shading(i), triangle_material(i), normal(i) and uv(i).
 #pragma once
 
+#include <type_traits>
+
 #include "wavetrace/geometry/bvh.hpp"
 #include "wavetrace/geometry/instance.hpp"
 #include "wavetrace/geometry/sphere.hpp"
@@ -25,6 +27,17 @@ constexpr int kReturnToWorld = -1;
 constexpr uint32_t kind_bit(PrimitiveKind k) { return 1u << static_cast<uint32_t>(k); }
 constexpr uint32_t kSpheresOnly = kind_bit(PrimitiveKind::Sphere);
 constexpr uint32_t kAllKinds = kind_bit(PrimitiveKind::Sphere) | kind_bit(PrimitiveKind::Triangle);
+
+// The one choice of kernel by a scene's kinds (host side): calls f with the set a
+// kernel is compiled for, as a std::integral_constant: spheres alone, or all kinds.
+template <class F>
+inline void with_kinds(uint32_t scene_kinds, F&& f) {
+  if (scene_kinds == kSpheresOnly) {
+    f(std::integral_constant<uint32_t, kSpheresOnly>{});
+  } else {
+    f(std::integral_constant<uint32_t, kAllKinds>{});
+  }
+}
 
 // Tests the `count` primitives from `first` of an instance of `kind`, narrowing `hit`.
 template <uint32_t Kinds, class Geometry>
@@ -57,8 +70,9 @@ template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   if (g.node_count() == 0) return hit;
-  // Only triangle instances are ever transformed (spheres stand untransformed).
-  constexpr bool kTransforms = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
+  // Only triangle instances are ever transformed (spheres stand untransformed), and
+  // only triangles need the slab test's round-up (spheres' boxes are padded).
+  constexpr bool kTriangles = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
   Ray ray = world;
   vec3 inv = slab_inverse(world.dir);
   TriangleRay tr{};
@@ -66,7 +80,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   PrimitiveKind kind = PrimitiveKind::Sphere;
   // Spheres alone stand in one instance: the top level is a single leaf, and the
   // stack holds the return mark and one tree's deferred nodes.
-  constexpr int kStack = kTransforms ? kBvhStackSize : kMaxBvhDepth + 1;
+  constexpr int kStack = kTriangles ? kBvhStackSize : kMaxBvhDepth + 1;
   int stack[kStack];
   float stack_t[kStack];
   int top = 0;
@@ -77,12 +91,12 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       instance = n.left_or_first;
       const Instance& in = g.instance(instance);
       kind = in.kind;
-      if (kTransforms && !in.identity) {
+      if (kTriangles && !in.identity) {
         ray.origin = in.object_from_world.point(world.origin);
         ray.dir = in.object_from_world.vector(world.dir);
         inv = slab_inverse(ray.dir);
       }
-      if ((Kinds & kind_bit(PrimitiveKind::Triangle)) && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
+      if (kTriangles && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
       if (top < kStack) {
         stack[top] = kReturnToWorld;
         stack_t[top++] = 0.0f;
@@ -94,8 +108,8 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
     } else {
       int a = n.left_or_first, b = n.left_or_first + 1;
-      float ta = box_entry<kTransforms>(g.node(a), ray.origin, inv, hit.t);
-      float tb = box_entry<kTransforms>(g.node(b), ray.origin, inv, hit.t);
+      float ta = box_entry<kTriangles>(g.node(a), ray.origin, inv, hit.t);
+      float tb = box_entry<kTriangles>(g.node(b), ray.origin, inv, hit.t);
       if (ta > tb) {
         float tt = ta;
         ta = tb;
@@ -118,7 +132,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
     while (top > 0) {
       --top;
       if (stack[top] == kReturnToWorld) {
-        if (kTransforms) {
+        if (kTriangles) {
           ray = world;
           inv = slab_inverse(world.dir);
         }
