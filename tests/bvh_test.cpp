@@ -5,12 +5,16 @@
 #include <random>
 #include <utility>
 
+#include "bvh_support.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt {
 namespace {
+
+using test::box_contains;
+using test::walk;
 
 struct SphereSet {
   std::string name;
@@ -133,29 +137,6 @@ int depth_below(const std::vector<BvhNode>& nodes, int node) {
   return 1 + std::max(depth_below(nodes, left), depth_below(nodes, left + 1));
 }
 
-// Calls visit(node, parent) for every node reachable from the root, depth first.
-template <class Visit>
-void walk(const std::vector<BvhNode>& nodes, int root, Visit visit) {
-  std::vector<std::pair<int, int>> todo = {{root, -1}};
-  while (!todo.empty()) {
-    auto [node, parent] = todo.back();
-    todo.pop_back();
-    ASSERT_GE(node, 0);
-    ASSERT_LT(node, static_cast<int>(nodes.size()));
-    visit(node, parent);
-    if (nodes[node].count == 0) {
-      todo.push_back({nodes[node].left_or_first, node});
-      todo.push_back({nodes[node].left_or_first + 1, node});
-    }
-  }
-}
-
-bool box_contains(const BvhNode& outer, const float lo[3], const float hi[3]) {
-  for (int k = 0; k < 3; ++k) {
-    if (lo[k] < outer.lo[k] || hi[k] > outer.hi[k]) return false;
-  }
-  return true;
-}
 
 TEST(Bvh, ClosestHitMatchesBruteForce) {
   uint32_t seed = 100;
@@ -225,12 +206,12 @@ TEST(Bvh, NodeBoundsContainTheirChildrenAndSpheres) {
     walk(scene.nodes, sphere_root(scene), [&](int node, int parent) {
       const BvhNode& n = scene.nodes[node];
       if (parent >= 0) {
-        EXPECT_TRUE(box_contains(scene.nodes[parent], n.lo, n.hi)) << "node " << node;
+        EXPECT_TRUE(box_contains(scene.nodes[parent], n)) << "node " << node;
       }
       for (int i = n.left_or_first; n.count > 0 && i < n.left_or_first + n.count; ++i) {
         const SphereGeom& s = scene.spheres[i];
-        float lo[3] = {s.x - s.w, s.y - s.w, s.z - s.w}, hi[3] = {s.x + s.w, s.y + s.w, s.z + s.w};
-        EXPECT_TRUE(box_contains(n, lo, hi)) << "sphere " << i;
+        const vec3 c(s.x, s.y, s.z);
+        EXPECT_TRUE(box_contains(n, c - vec3(s.w), c + vec3(s.w))) << "sphere " << i;
       }
     });
   }

@@ -11,12 +11,15 @@
 
 #include "mesh_support.hpp"
 #include "render/renderer.hpp"
+#include "render_support.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt {
 namespace {
+
+using test::mean_abs_diff;
 
 // A ground quad (two triangles, y = -1) under the object, so that the object
 // casts shadows and light bounces between the two.
@@ -51,18 +54,8 @@ std::string scene_json(const std::string& object_file, const std::string& placin
 }
 
 RenderResult render_cpu(const Scene& scene, Kernel kernel = Kernel::Megakernel) {
-  RenderOptions o;
-  o.backend = Backend::Cpu;
-  o.kernel = kernel;
-  o.params = RenderParams{48, 32, 4, 4, 100, 9};  // no roulette: paths differ only where geometry does
-  o.wave_size = 4096;
-  return render(scene, o);
-}
-
-double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.size(); ++i) s += std::fabs(static_cast<double>(a[i]) - b[i]);
-  return s / a.size();
+  // No roulette: paths differ only where the geometry does.
+  return render(scene, test::options_for(Backend::Cpu, kernel, 48, 32, 4, 4, 100, 9));
 }
 
 size_t values_apart(const std::vector<float>& a, const std::vector<float>& b, float tolerance) {

@@ -8,6 +8,7 @@
 #include <random>
 #include <utility>
 
+#include "bvh_support.hpp"
 #include "mesh_support.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
@@ -16,6 +17,9 @@
 
 namespace wt {
 namespace {
+
+using test::box_contains;
+using test::walk;
 
 // A hit as brute force sees it: which placement, which triangle (an index into the
 // built scene's arrays, or a sphere's), where, and how close to the triangle's
@@ -285,29 +289,6 @@ TEST(MeshBvh, SpheresAndTransformedInstancesMatchBruteForce) {
 
 // ---- The trees ----
 
-template <class Visit>
-void walk(const std::vector<BvhNode>& nodes, int root, Visit visit) {
-  std::vector<std::pair<int, int>> todo = {{root, -1}};
-  while (!todo.empty()) {
-    auto [node, parent] = todo.back();
-    todo.pop_back();
-    ASSERT_GE(node, 0);
-    ASSERT_LT(node, static_cast<int>(nodes.size()));
-    visit(node, parent);
-    if (nodes[node].count == 0) {
-      todo.push_back({nodes[node].left_or_first, node});
-      todo.push_back({nodes[node].left_or_first + 1, node});
-    }
-  }
-}
-
-bool contains(const BvhNode& outer, const vec3& lo, const vec3& hi) {
-  for (int k = 0; k < 3; ++k) {
-    if (lo[k] < outer.lo[k] || hi[k] > outer.hi[k]) return false;
-  }
-  return true;
-}
-
 Scene three_meshes_placed_twice() {
   Scene s;
   s.source = "trees";
@@ -368,7 +349,7 @@ TEST(MeshBvh, NodeBoundsContainTheirChildrenAndTriangles) {
     walk(s.nodes, root, [&](int node, int parent) {
       const BvhNode& n = s.nodes[node];
       if (parent >= 0) {
-        EXPECT_TRUE(contains(s.nodes[parent], vec3(n.lo[0], n.lo[1], n.lo[2]), vec3(n.hi[0], n.hi[1], n.hi[2])))
+        EXPECT_TRUE(box_contains(s.nodes[parent], n))
             << "node " << node;
       }
       if (n.count == 0) return;
@@ -376,7 +357,7 @@ TEST(MeshBvh, NodeBoundsContainTheirChildrenAndTriangles) {
       for (int i = n.left_or_first; i < n.left_or_first + n.count; ++i) {
         for (int c = 0; c < 3; ++c) {
           const vec3 p = s.triangles[i].corner(c);
-          EXPECT_TRUE(contains(n, p, p)) << "triangle " << i << " corner " << c;
+          EXPECT_TRUE(box_contains(n, p, p)) << "triangle " << i << " corner " << c;
         }
       }
     });
@@ -396,7 +377,7 @@ TEST(MeshBvh, TopLevelHoldsEachInstanceOnceInsideItsBounds) {
     todo.pop_back();
     const BvhNode& n = s.nodes[node];
     if (parent >= 0) {
-      EXPECT_TRUE(contains(s.nodes[parent], vec3(n.lo[0], n.lo[1], n.lo[2]), vec3(n.hi[0], n.hi[1], n.hi[2])))
+      EXPECT_TRUE(box_contains(s.nodes[parent], n))
           << "node " << node;
     }
     if (n.count == 0) {
@@ -412,7 +393,7 @@ TEST(MeshBvh, TopLevelHoldsEachInstanceOnceInsideItsBounds) {
       const vec3 c((corner & 1) ? root.hi[0] : root.lo[0], (corner & 2) ? root.hi[1] : root.lo[1],
                    (corner & 4) ? root.hi[2] : root.lo[2]);
       const vec3 w = in.world_from_object.point(c);
-      EXPECT_TRUE(contains(n, w, w)) << "instance " << n.left_or_first << " corner " << corner;
+      EXPECT_TRUE(box_contains(n, w, w)) << "instance " << n.left_or_first << " corner " << corner;
     }
   }
   for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "instance " << i;

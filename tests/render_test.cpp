@@ -9,10 +9,18 @@
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
 #include "render/renderer.hpp"
+#include "render_support.hpp"
 #include "test_support.hpp"
 
 namespace wt {
 namespace {
+
+using test::all_variants;
+using test::mean;
+using test::mean_abs_diff;
+using test::options_for;
+using test::Variant;
+using test::variant_name;
 
 // A Lambertian sphere of albedo 1 under a uniform sky of radiance 1: every path
 // carries throughput 1 until it escapes, so every pixel's expected value is 1.
@@ -26,35 +34,7 @@ Scene furnace_scene() {
                      "furnace.json");
 }
 
-RenderOptions options_for(Backend b, Kernel k, int w, int h, int spp, int depth, int roulette, uint32_t seed) {
-  RenderOptions o;
-  o.backend = b;
-  o.kernel = k;
-  o.params = RenderParams{w, h, spp, depth, roulette, seed};
-  o.wave_size = 4096;  // several waves even for small images: regeneration is exercised
-  return o;
-}
 
-double mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }
-
-double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
-  double s = 0;
-  for (size_t i = 0; i < a.size(); ++i) s += std::fabs(static_cast<double>(a[i]) - b[i]);
-  return s / a.size();
-}
-
-struct Variant {
-  Backend backend;
-  Kernel kernel;
-};
-
-void PrintTo(const Variant& v, std::ostream* os) { *os << backend_name(v.backend) << "/" << kernel_name(v.kernel); }
-
-std::string variant_name(const testing::TestParamInfo<Variant>& info) {
-  std::string n = std::string(backend_name(info.param.backend)) + "_" + kernel_name(info.param.kernel);
-  for (char& c : n) c = c == '-' ? '_' : c;
-  return n;
-}
 
 class EveryKernel : public testing::TestWithParam<Variant> {
  protected:
@@ -199,12 +179,6 @@ TEST(RenderSettings, BigRendersPassTheChecks) {
   EXPECT_NO_THROW(validate_params(p));
 }
 
-std::vector<Variant> all_variants() {
-  return {{Backend::Cpu, Kernel::Megakernel},           {Backend::Cpu, Kernel::Wavefront},
-          {Backend::Cpu, Kernel::WavefrontUnsorted},    {Backend::Cuda, Kernel::Megakernel},
-          {Backend::Cuda, Kernel::MegakernelConstant},  {Backend::Cuda, Kernel::Wavefront},
-          {Backend::Cuda, Kernel::WavefrontUnsorted}};
-}
 
 INSTANTIATE_TEST_SUITE_P(Render, EveryKernel, testing::ValuesIn(all_variants()), variant_name);
 
