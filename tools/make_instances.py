@@ -24,7 +24,6 @@ seeds: the output is the same on every run. The summary line gives the
 unique and the instanced triangle counts.
 """
 
-import argparse
 import os
 import random
 import time
@@ -84,12 +83,8 @@ def counts(scene, tris):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--output", default=scenefile.scene_path("instances.json"), help="scene file to write")
-    args = ap.parse_args()
+    output, folder = meshfile.scene_command(__doc__, "instances.json")
     start = time.time()
-    folder = os.path.join(os.path.dirname(os.path.abspath(args.output)), "generated")
-    os.makedirs(folder, exist_ok=True)
     tris = {"ground": 2}
     meshfile.write_ground_obj(os.path.join(folder, "ground-quad.obj"))
     tris["tree"] = meshfile.write_glb(os.path.join(folder, "tree.glb"), meshfile.tree_parts(seed=3), "tree")
@@ -97,11 +92,11 @@ def main():
                                              meshfile.tree_parts(seed=11, leaves=(0.62, 0.3, 0.06)), "tree-autumn")
     tris["rock"] = meshfile.write_glb(os.path.join(folder, "rock.glb"), [meshfile.rock_part(4, seed=7)], "rock")
     scene = build(tris)
-    with open(args.output, "w") as f:
+    with open(output, "w") as f:
         f.write(scenefile.dumps_scene(scene))
     unique, placed = counts(scene, tris)
     print("%s: %d instances of %d meshes; %d unique triangles, %d instanced triangles; %.1f s"
-          % (os.path.normpath(args.output), len(scene["instances"]), len(scene["meshes"]), unique, placed,
+          % (os.path.normpath(output), len(scene["instances"]), len(scene["meshes"]), unique, placed,
              time.time() - start))
 
 

@@ -27,7 +27,6 @@ file's own). Everything random comes from fixed seeds: the output is the same
 on every run. A gradient sky, a camera low over the near edge looking across.
 """
 
-import argparse
 import array
 import math
 import os
@@ -164,23 +163,19 @@ def build(h, terrain_file, rock_file):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("-o", "--output", default=scenefile.scene_path("terrain.json"), help="scene file to write")
-    args = ap.parse_args()
+    output, folder = meshfile.scene_command(__doc__, "terrain.json")
     start = time.time()
-    folder = os.path.join(os.path.dirname(os.path.abspath(args.output)), "generated")
-    os.makedirs(folder, exist_ok=True)
     h = heights()
     terrain = terrain_part(h)
     t_tris = meshfile.write_glb(os.path.join(folder, "terrain.glb"), [terrain], "terrain")
     del terrain
     r_tris = meshfile.write_glb(os.path.join(folder, "rock.glb"), [meshfile.rock_part(4, seed=7)], "rock")
     scene = build(h, "generated/terrain.glb", "generated/rock.glb")
-    with open(args.output, "w") as f:
+    with open(output, "w") as f:
         f.write(scenefile.dumps_scene(scene))
     rocks = len(scene["instances"]) - 1
     print("%s: terrain %d triangles, rock %d triangles x %d instances; %d unique, %d instanced triangles; %.1f s"
-          % (os.path.normpath(args.output), t_tris, r_tris, rocks, t_tris + r_tris, t_tris + rocks * r_tris,
+          % (os.path.normpath(output), t_tris, r_tris, rocks, t_tris + r_tris, t_tris + rocks * r_tris,
              time.time() - start))
 
 

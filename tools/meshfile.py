@@ -477,6 +477,20 @@ def _main(argv):
     sys.exit(1 if failed else 0)
 
 
+def scene_command(doc, default_name):
+    """The command line of a generator that writes a scene and the meshes it names:
+    [-o OUTPUT]. Returns (OUTPUT, the folder generated/ beside it, made if absent),
+    where the meshes go and where the scene's "generated/..." paths point."""
+    import argparse
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("-o", "--output", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
+                                                             "scenes", default_name), help="scene file to write")
+    output = ap.parse_args().output
+    folder = os.path.join(os.path.dirname(os.path.abspath(output)), "generated")
+    os.makedirs(folder, exist_ok=True)
+    return output, folder
+
+
 if __name__ == "__main__":
     _main(sys.argv[1:])
 
