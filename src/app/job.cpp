@@ -105,7 +105,7 @@ void print_geometry(const Scene::Summary& g) {
   }
   for (const auto& m : g.meshes) {
     std::fprintf(stderr, "mesh %s: %zu triangles, BVH %zu nodes, depth %d, SAH cost %.1f\n", m.name.c_str(),
-                 m.triangles, m.bvh.nodes, m.bvh.depth, m.bvh.sah_cost);
+                 size_t{m.triangle_count}, m.bvh.nodes, m.bvh.depth, m.bvh.sah_cost);
   }
 }
 

@@ -38,7 +38,7 @@ nlohmann::json geometry_json(const Scene::Summary& g) {
   for (const auto& m : g.meshes) {
     meshes.push_back({{"name", m.name},
                       {"file", m.file},
-                      {"triangles", m.triangles},
+                      {"triangles", m.triangle_count},
                       {"dropped_degenerate", m.dropped_degenerate},
                       {"dropped_nan", m.dropped_nan},
                       {"bvh", bvh_json(m.bvh)}});

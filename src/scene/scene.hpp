@@ -124,12 +124,7 @@ struct Scene::Summary {
   size_t device_bytes = 0;
   BvhStats top_level_bvh;
   BvhStats sphere_bvh;
-  struct Mesh {
-    std::string name, file;
-    size_t triangles, dropped_degenerate, dropped_nan;
-    BvhStats bvh;
-  };
-  std::vector<Mesh> meshes;
+  std::vector<SceneMesh> meshes;
 };
 
 // Reads, validates and prepares (BVH built, sort keys set) a scene file.

@@ -195,10 +195,10 @@ Scene::Summary Scene::summary() const {
   s.device_bytes = device_bytes();
   s.top_level_bvh = top_level_bvh;
   s.sphere_bvh = sphere_bvh;
+  s.meshes = meshes;
   for (const SceneMesh& m : meshes) {
     s.dropped_degenerate += m.dropped_degenerate;
     s.dropped_nan += m.dropped_nan;
-    s.meshes.push_back({m.name, m.file, m.triangle_count, m.dropped_degenerate, m.dropped_nan, m.bvh});
   }
   return s;
 }
