@@ -22,7 +22,7 @@ struct RenderParams {
 // the CPU). The constant-memory megakernel has an accessor of the same shape.
 // The accessor functions are the ones geometry/geometry.hpp names.
 struct SceneView {
-  const BvhNode* nodes;  // the top level over instances first, then each instance's
+  const WideBvhNode* nodes;  // the top level over instances first, then each instance's
   const Instance* instances;
   const SphereGeom* spheres;
   const uint32_t* sphere_materials;
@@ -40,7 +40,26 @@ struct SceneView {
   Camera camera;
 
   WT_HD int node_count() const { return node_total; }
-  WT_HD BvhNode node(int i) const { return nodes[i]; }
+  // A node in six 16-byte loads (through the read-only cache on the GPU).
+  WT_HD WideBvhNode node(int i) const {
+#ifdef __CUDA_ARCH__
+    WideBvhNode n;
+    const int4* from = reinterpret_cast<const int4*>(nodes + i);
+    int4* to = reinterpret_cast<int4*>(&n);
+WT_UNROLL
+    for (int k = 0; k < 6; ++k) to[k] = __ldg(from + k);
+    return n;
+#else
+    return nodes[i];
+#endif
+  }
+  WT_HD int32_t node_child(int i, int slot) const {
+#ifdef __CUDA_ARCH__
+    return __ldg(&nodes[i].child[slot]);
+#else
+    return nodes[i].child[slot];
+#endif
+  }
   WT_HD const Instance& instance(int i) const { return instances[i]; }
   WT_HD SphereGeom sphere(int i) const { return spheres[i]; }
   WT_HD uint32_t sphere_material(int i) const { return sphere_materials[i]; }

@@ -1,4 +1,4 @@
-// Binned-SAH BVH over boxes, in the layout geometry/bvh.hpp traverses.
+// Binned-SAH BVH over boxes, collapsed into the layout geometry/bvh.hpp traverses.
 #include "scene/bvh_build.hpp"
 
 #include <algorithm>
@@ -214,6 +214,156 @@ BvhStats bvh_stats(const std::vector<BvhNode>& nodes, const BvhBuildOptions& opt
       stats.sah_cost += p * options.traversal_cost;
       todo.push_back({n.left_or_first, depth + 1});
       todo.push_back({n.left_or_first + 1, depth + 1});
+    }
+  }
+  return stats;
+}
+
+Aabb child_bounds(const WideBvhNode& n, int slot) {
+  Aabb b;
+  child_box(n, slot, b.lo, b.hi);
+  return b;
+}
+
+Aabb wide_bounds(const WideBvhNode& n) {
+  Aabb b;
+  for (int s = 0; s < n.child_count(); ++s) b.grow(child_bounds(n, s));
+  return b;
+}
+
+namespace {
+
+// What child_box decodes for grid value q on one axis (the same float arithmetic).
+float decoded(float origin, uint32_t exponent, int q) { return origin + static_cast<float>(q) * grid_step(exponent); }
+
+// The grid of one axis: the smallest step whose 255 cells reach from `lo` to `hi`.
+uint32_t grid_exponent(float lo, float hi) {
+  const double extent = static_cast<double>(hi) - static_cast<double>(lo);
+  int e = 1;
+  if (extent > 0.0) e = std::clamp(static_cast<int>(std::floor(std::log2(extent / 255.0))) + 127, 1, 254);
+  while (e < 254 && decoded(lo, static_cast<uint32_t>(e), 255) < hi) ++e;
+  return static_cast<uint32_t>(e);
+}
+
+class Collapser {
+ public:
+  Collapser(std::vector<WideBvhNode>& out, const std::vector<BvhNode>& tree, uint32_t first_prim)
+      : out_(out), tree_(tree), first_prim_(first_prim) {}
+
+  int32_t collapse(int b) {
+    // The children: the binary node's own two, then repeatedly the two of the inner
+    // one of largest area in place of it (a leaf root stands as the one child).
+    int slots[kBvhWidth];
+    int used = 0;
+    if (tree_[b].count > 0) {
+      slots[used++] = b;
+    } else {
+      slots[used++] = tree_[b].left_or_first;
+      slots[used++] = tree_[b].left_or_first + 1;
+    }
+    while (used < kBvhWidth) {
+      int best = -1;
+      double best_area = -1.0;
+      for (int s = 0; s < used; ++s) {
+        const BvhNode& c = tree_[slots[s]];
+        if (c.count == 0 && node_bounds(c).area() > best_area) {
+          best_area = node_bounds(c).area();
+          best = s;
+        }
+      }
+      if (best < 0) break;
+      const int first = tree_[slots[best]].left_or_first;
+      slots[best] = first;
+      slots[used++] = first + 1;
+    }
+
+    const int32_t index = static_cast<int32_t>(out_.size());
+    out_.emplace_back();
+    WideBvhNode n{};
+    n.meta = static_cast<uint32_t>(used) << 24;
+    Aabb box;
+    for (int s = 0; s < used; ++s) box.grow(node_bounds(tree_[slots[s]]));
+    for (int k = 0; k < 3; ++k) {
+      n.origin[k] = box.lo[k];
+      n.meta |= grid_exponent(box.lo[k], box.hi[k]) << (8 * k);
+    }
+    for (int s = 0; s < used; ++s) {
+      const Aabb c = node_bounds(tree_[slots[s]]);
+      for (int k = 0; k < 3; ++k) quantize(n, k, s, c.lo[k], c.hi[k]);
+    }
+    for (int s = 0; s < used; ++s) {
+      const BvhNode& c = tree_[slots[s]];
+      if (c.count > 0) {
+        const uint64_t first = uint64_t(first_prim_) + static_cast<uint32_t>(c.left_or_first);
+        if (first + c.count > uint64_t(kMaxLeafFirst) || c.count > kMaxLeafCount) {
+          throw std::length_error("too many primitives for the BVH's leaves (at most " +
+                                  std::to_string(kMaxLeafFirst) + ")");
+        }
+        n.child[s] = leaf_ref(static_cast<int32_t>(first), c.count);
+      } else {
+        n.child[s] = collapse(slots[s]);
+      }
+    }
+    out_[index] = n;
+    return index;
+  }
+
+ private:
+  // The grid cells of [lo, hi] on axis k, rounded outward so that the decoded box
+  // contains it.
+  static void quantize(WideBvhNode& n, int k, int slot, float lo, float hi) {
+    const float o = n.origin[k];
+    const uint32_t e = n.exponent(k);
+    const double step = grid_step(e);
+    int qlo = std::clamp(static_cast<int>(std::floor((double(lo) - o) / step)), 0, 255);
+    while (qlo > 0 && decoded(o, e, qlo) > lo) --qlo;
+    int qhi = std::clamp(static_cast<int>(std::ceil((double(hi) - o) / step)), 0, 255);
+    while (qhi < 255 && decoded(o, e, qhi) < hi) ++qhi;
+    if (decoded(o, e, qlo) > lo || decoded(o, e, qhi) < hi) {
+      throw std::logic_error("a BVH child box does not fit its node's grid");
+    }
+    const int word = 2 * k + (slot >> 2), shift = 8 * (slot & 3);
+    n.lo[word] |= static_cast<uint32_t>(qlo) << shift;
+    n.hi[word] |= static_cast<uint32_t>(qhi) << shift;
+  }
+
+  std::vector<WideBvhNode>& out_;
+  const std::vector<BvhNode>& tree_;
+  uint32_t first_prim_;
+};
+
+}  // namespace
+
+int32_t append_wide(std::vector<WideBvhNode>& out, const std::vector<BvhNode>& tree, uint32_t first_prim) {
+  return Collapser(out, tree, first_prim).collapse(0);
+}
+
+BvhStats bvh_stats(const std::vector<WideBvhNode>& nodes, int32_t root, const BvhBuildOptions& options) {
+  BvhStats stats;
+  if (nodes.empty()) return stats;
+  const double root_area = wide_bounds(nodes[root]).area();
+  auto share = [&](const Aabb& b) { return root_area > 0.0 ? b.area() / root_area : 1.0; };
+  struct Todo {
+    int32_t node;
+    int depth;
+    double p;  // the node's share of the root's area
+  };
+  std::vector<Todo> todo{{root, 1, 1.0}};
+  while (!todo.empty()) {
+    const Todo t = todo.back();
+    todo.pop_back();
+    const WideBvhNode& n = nodes[t.node];
+    ++stats.nodes;
+    stats.depth = std::max(stats.depth, t.depth);
+    stats.sah_cost += t.p * options.traversal_cost;
+    for (int s = 0; s < n.child_count(); ++s) {
+      const double p = share(child_bounds(n, s));
+      if (is_leaf(n.child[s])) {
+        ++stats.leaves;
+        stats.sah_cost += p * leaf_count(n.child[s]);
+      } else {
+        todo.push_back({n.child[s], t.depth + 1, p});
+      }
     }
   }
   return stats;

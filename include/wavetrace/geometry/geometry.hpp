@@ -4,7 +4,7 @@
 // switch here, and its bounds in the host's scene builder; no kernel changes.
 //
 // The scene accessor `g` (SceneView, or the constant-memory scene) provides
-// node_count(), node(i), instance(i), sphere(i), sphere_material(i), triangle(i),
+// node_count(), node(i), node_child(i, slot), instance(i), sphere(i), sphere_material(i), triangle(i),
 // triangle_shading(i), triangle_material(i), normal(i) and uv(i).
 #pragma once
 
@@ -62,10 +62,39 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
   }
 }
 
-// The closest hit along `world` before tmax. The top-level BVH's leaves are single
-// instances; entering one moves the ray into the instance's object space (where t
-// measures the same distances: the direction is transformed, not renormalised) and
-// pushes the mark of the way back.
+// The children of `n` that the ray enters before tmax, nearest first: slot + 1 in
+// each 4-bit field from the lowest up, 0 after the last (0 when none is entered).
+template <bool RoundUp>
+WT_HD WT_INLINE uint32_t children_in_order(const WideBvhNode& n, const vec3& o, const vec3& inv, float tmax) {
+  float t[kBvhWidth];
+  bool entered[kBvhWidth];
+WT_UNROLL
+  for (int s = 0; s < kBvhWidth; ++s) {
+    vec3 lo, hi;
+    child_box(n, s, lo, hi);
+    t[s] = box_entry<RoundUp>(lo, hi, o, inv, tmax);
+    entered[s] = s < n.child_count() && t[s] <= tmax;
+  }
+  // Each entered child's rank among the entered ones (ties in slot order).
+  uint32_t order = 0;
+WT_UNROLL
+  for (int s = 0; s < kBvhWidth; ++s) {
+    uint32_t rank = 0;
+WT_UNROLL
+    for (int j = 0; j < kBvhWidth; ++j) {
+      if (j != s) rank += (entered[j] && (t[j] < t[s] || (t[j] == t[s] && j < s))) ? 1u : 0u;
+    }
+    if (entered[s]) order |= static_cast<uint32_t>(s + 1) << (4 * rank);
+  }
+  return order;
+}
+
+// The closest hit along `world` before tmax. A node's children are visited nearest
+// entry first; the rest wait on the stack as one entry (the node and the order of
+// the children left), so the stack holds at most one entry per level. The top-level
+// BVH's leaves are single instances; entering one moves the ray into the instance's
+// object space (where t measures the same distances: the direction is transformed,
+// not renormalised) and pushes the mark of the way back.
 template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
@@ -79,16 +108,28 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   int instance = -1;
   PrimitiveKind kind = PrimitiveKind::Sphere;
   // Spheres alone stand in one instance: the top level is a single leaf, and the
-  // stack holds the return mark and one tree's deferred nodes.
+  // stack holds the return mark and one tree's deferred entries.
   constexpr int kStack = kTriangles ? kBvhStackSize : kMaxBvhDepth + 1;
-  int stack[kStack];
-  float stack_t[kStack];
+  int32_t stack_node[kStack];
+  uint32_t stack_order[kStack];
   int top = 0;
-  int node = 0;
+  int32_t ref = 0;  // the top level's root
   for (;;) {
-    BvhNode n = g.node(node);
-    if (n.count > 0 && instance < 0) {
-      instance = n.left_or_first;
+    if (!is_leaf(ref)) {
+      const WideBvhNode n = g.node(ref);
+      uint32_t order = children_in_order<kTriangles>(n, ray.origin, inv, hit.t);
+      if (order != 0) {
+        const int slot = static_cast<int>(order & 15u) - 1;
+        order >>= 4;
+        if (order != 0 && top < kStack) {
+          stack_node[top] = ref;
+          stack_order[top++] = order;
+        }
+        ref = child_in_slot(n, slot);
+        continue;
+      }
+    } else if (instance < 0) {
+      instance = leaf_first(ref);
       const Instance& in = g.instance(instance);
       kind = in.kind;
       if (kTriangles && !in.identity) {
@@ -98,40 +139,20 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       }
       if (kTriangles && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
       if (top < kStack) {
-        stack[top] = kReturnToWorld;
-        stack_t[top++] = 0.0f;
+        stack_node[top] = kReturnToWorld;
+        stack_order[top++] = 0;
       }
-      node = in.root;
+      ref = in.root;
       continue;
-    }
-    if (n.count > 0) {
-      intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
     } else {
-      int a = n.left_or_first, b = n.left_or_first + 1;
-      float ta = box_entry<kTriangles>(g.node(a), ray.origin, inv, hit.t);
-      float tb = box_entry<kTriangles>(g.node(b), ray.origin, inv, hit.t);
-      if (ta > tb) {
-        float tt = ta;
-        ta = tb;
-        tb = tt;
-        int ti = a;
-        a = b;
-        b = ti;
-      }
-      if (ta <= hit.t) {
-        if (tb <= hit.t && top < kStack) {
-          stack[top] = b;
-          stack_t[top++] = tb;
-        }
-        node = a;
-        continue;
-      }
+      intersect_leaf<Kinds>(g, kind, instance, leaf_first(ref), leaf_count(ref), ray, tr, hit);
     }
-    // Pop, skipping nodes whose boxes the closest hit so far already passed.
+    // Pop: the nearest child left of the deepest deferred node.
     bool found = false;
     while (top > 0) {
-      --top;
-      if (stack[top] == kReturnToWorld) {
+      const int32_t node = stack_node[top - 1];
+      if (node == kReturnToWorld) {
+        --top;
         if (kTriangles) {
           ray = world;
           inv = slab_inverse(world.dir);
@@ -139,11 +160,17 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
         instance = -1;
         continue;
       }
-      if (stack_t[top] <= hit.t) {
-        node = stack[top];
-        found = true;
-        break;
+      uint32_t order = stack_order[top - 1];
+      const int slot = static_cast<int>(order & 15u) - 1;
+      order >>= 4;
+      if (order == 0) {
+        --top;
+      } else {
+        stack_order[top - 1] = order;
       }
+      ref = g.node_child(node, slot);
+      found = true;
+      break;
     }
     if (!found) break;
   }
