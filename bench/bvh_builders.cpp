@@ -199,9 +199,15 @@ constexpr float kTMax = 1e30f;
 // they build, before scene_bvh.cpp collapses ours into the wide layout. The stack
 // here is deep enough for any tree, so that a tree deeper than the renderer's
 // stack still gives the right answer (its depth is reported).
+// The slab test: the entry distance, or a value > tmax when the box is missed.
 float entry(const BvhNode& n, const vec3& o, const vec3& inv, float tmax) {
-  const Aabb b = node_bounds(n);
-  return box_entry(b.lo, b.hi, o, inv, tmax);
+  float enter = 0.0f, leave = tmax;
+  for (int k = 0; k < 3; ++k) {
+    const float t0 = (n.lo[k] - o[k]) * inv[k], t1 = (n.hi[k] - o[k]) * inv[k];
+    enter = std::max(enter, std::min(t0, t1));
+    leave = std::min(leave, std::max(t0, t1) * 1.0000004f);
+  }
+  return enter <= leave ? enter : tmax * 2.0f + 1.0f;
 }
 
 TraceCounts trace(const BvhTree& tree, const std::vector<TriangleGeom>& tris, const vec3& o, const vec3& d) {

@@ -219,9 +219,29 @@ BvhStats bvh_stats(const std::vector<BvhNode>& nodes, const BvhBuildOptions& opt
   return stats;
 }
 
+namespace {
+
+// Grid value q on one axis of a node, exactly (in double: a float plus an 8-bit
+// integer times a power of two).
+double decoded(float origin, uint32_t exponent, int q) {
+  return static_cast<double>(origin) + q * static_cast<double>(grid_step(exponent));
+}
+
+// The float at or below (down) or at or above x.
+float round_float(double x, bool down) {
+  const float f = static_cast<float>(x);
+  if (down) return static_cast<double>(f) > x ? std::nextafter(f, -FLT_MAX) : f;
+  return static_cast<double>(f) < x ? std::nextafter(f, FLT_MAX) : f;
+}
+
+}  // namespace
+
 Aabb child_bounds(const WideBvhNode& n, int slot) {
   Aabb b;
-  child_box(n, slot, b.lo, b.hi);
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = round_float(decoded(n.origin[k], n.exponent(k), static_cast<int>(n.grid_lo(k, slot))), true);
+    b.hi[k] = round_float(decoded(n.origin[k], n.exponent(k), static_cast<int>(n.grid_hi(k, slot))), false);
+  }
   return b;
 }
 
@@ -232,9 +252,6 @@ Aabb wide_bounds(const WideBvhNode& n) {
 }
 
 namespace {
-
-// What child_box decodes for grid value q on one axis (the same float arithmetic).
-float decoded(float origin, uint32_t exponent, int q) { return origin + static_cast<float>(q) * grid_step(exponent); }
 
 // The grid of one axis: the smallest step whose 255 cells reach from `lo` to `hi`.
 uint32_t grid_exponent(float lo, float hi) {

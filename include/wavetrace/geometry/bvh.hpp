@@ -32,11 +32,9 @@ WT_HD WT_INLINE constexpr int leaf_count(int32_t ref) {
 }
 
 // Up to eight children. Their boxes are stored on a grid of the node's own: on axis
-// k, child s spans origin[k] + lo * 2^e[k] to origin[k] + hi * 2^e[k], where lo and
-// hi are 8-bit grid values (grid_lo, grid_hi). The builder rounds the grid outward,
-// so a decoded box contains the child's exact box, and checks it with the same
-// arithmetic as child_box: the product is exact (an 8-bit integer times a power of
-// two), and the one rounding of the sum is the same on every backend.
+// k, child s spans origin[k] + lo * 2^e[k] to origin[k] + hi * 2^e[k] (exactly,
+// in real numbers), where lo and hi are 8-bit grid values (grid_lo, grid_hi). The
+// builder rounds the grid outward, so that box contains the child's exact box.
 //
 // Every field is a 32-bit word, so that a node loaded into registers stays there:
 // the grid values are packed four to a word, slots 0-3 and 4-7 of axis k in words
@@ -55,27 +53,38 @@ struct alignas(32) WideBvhNode {
 };
 static_assert(sizeof(WideBvhNode) == 96, "a node is three 32-byte sectors");
 
-// 2^(e - 127) for a biased exponent e in 1 .. 254.
-WT_HD WT_INLINE float grid_step(uint32_t e) {
+WT_HD WT_INLINE float bits_float(uint32_t bits) {
 #ifdef __CUDA_ARCH__
-  return __int_as_float(static_cast<int>(e << 23));
+  return __uint_as_float(bits);
 #else
-  const uint32_t bits = e << 23;
   float f;
   __builtin_memcpy(&f, &bits, sizeof f);
   return f;
 #endif
 }
 
-// A child's decoded box.
-WT_HD WT_INLINE void child_box(const WideBvhNode& n, int slot, vec3& lo, vec3& hi) {
-  const vec3 step(grid_step(n.exponent(0)), grid_step(n.exponent(1)), grid_step(n.exponent(2)));
-  lo = vec3(n.origin[0] + static_cast<float>(n.grid_lo(0, slot)) * step.x,
-            n.origin[1] + static_cast<float>(n.grid_lo(1, slot)) * step.y,
-            n.origin[2] + static_cast<float>(n.grid_lo(2, slot)) * step.z);
-  hi = vec3(n.origin[0] + static_cast<float>(n.grid_hi(0, slot)) * step.x,
-            n.origin[1] + static_cast<float>(n.grid_hi(1, slot)) * step.y,
-            n.origin[2] + static_cast<float>(n.grid_hi(2, slot)) * step.z);
+WT_HD WT_INLINE uint32_t float_bits(float f) {
+#ifdef __CUDA_ARCH__
+  return __float_as_uint(f);
+#else
+  uint32_t bits;
+  __builtin_memcpy(&bits, &f, sizeof bits);
+  return bits;
+#endif
+}
+
+// 2^(e - 127) for a biased exponent e in 1 .. 254.
+WT_HD WT_INLINE float grid_step(uint32_t e) { return bits_float(e << 23); }
+
+// Grid value `byte` (0-3) of a packed word, as a float: on the GPU one byte
+// permute into the bits of 2^23 + value and one exact subtraction, both full-rate
+// (an integer-to-float conversion is not).
+WT_HD WT_INLINE float grid_value(uint32_t word, int byte) {
+#ifdef __CUDA_ARCH__
+  return __uint_as_float(__byte_perm(word, 0x4B000000u, 0x7440u | static_cast<uint32_t>(byte))) - 8388608.0f;
+#else
+  return static_cast<float>((word >> (8 * byte)) & 255u);
+#endif
 }
 
 // The child in `slot` when slot is only known at run time: a choice among registers
@@ -94,31 +103,20 @@ WT_HD WT_INLINE int32_t child_in_slot(const WideBvhNode& n, int slot) {
 constexpr int kMaxBvhDepth = 24;
 constexpr int kBvhStackSize = 2 * kMaxBvhDepth + 1;
 
-// The slab test's far distances are rounded up by this factor (1 + 2 gamma(3) of
-// the three rounded operations behind each): a ray through an edge or corner that
-// lies on a box's face is never culled by the box's rounding, which the watertight
-// triangle test relies on.
-constexpr float kSlabRoundUp = 1.0000004f;
+// The relative widening of every slab, which makes the slab test conservative:
+// a child's entry and exit distances on an axis are computed as q * a + b from
+// per-node terms (a = step / d, b = (origin - o) / d, each rounded), which differ
+// from the exact distances to the exact grid box by at most about 6 roundings of
+// M = (255 step + |origin - o|) / |d|, the largest term. Every slab is widened by
+// 16 such roundings of M on each side (1e-6 M), so no box is culled that the ray
+// touches in exact arithmetic: a ray through a triangle's edge or corner on a box
+// face reaches the triangle test, which the watertight test relies on.
+constexpr float kSlabWidening = 1.0e-6f;
 
 // The reciprocal of a direction for the slab test. A zero component gives an
-// infinite reciprocal; a ray with it that starts exactly in the plane of a box's
-// face would make 0 * inf = NaN there and cull the box. The builder therefore
-// widens every triangle's box by an ulp on each side (scene_bvh.cpp): geometry
-// never lies in the plane of a face, and a ray in that plane cannot touch it.
+// infinite reciprocal, and 0 * inf = NaN where the ray starts in the plane of a
+// grid line; the min and max below drop a NaN, which leaves that axis unbounded:
+// the box is kept, never culled by it.
 WT_HD WT_INLINE vec3 slab_inverse(const vec3& d) { return vec3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
-
-// Slab test; returns the entry distance or a value > tmax when the box is missed.
-// RoundUp: widen the far side for rounding (needed for triangles; the spheres'
-// boxes are padded instead).
-template <bool RoundUp = true>
-WT_HD WT_INLINE float box_entry(const vec3& lo, const vec3& hi, const vec3& o, const vec3& inv, float tmax) {
-  constexpr float up = RoundUp ? kSlabRoundUp : 1.0f;
-  float tx0 = (lo.x - o.x) * inv.x, tx1 = (hi.x - o.x) * inv.x;
-  float ty0 = (lo.y - o.y) * inv.y, ty1 = (hi.y - o.y) * inv.y;
-  float tz0 = (lo.z - o.z) * inv.z, tz1 = (hi.z - o.z) * inv.z;
-  float tnear = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), 0.0f));
-  float tfar = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)) * up, fminf(fmaxf(tz0, tz1) * up, tmax));
-  return tnear <= tfar ? tnear : tmax * 2.0f + 1.0f;
-}
 
 }  // namespace wt
