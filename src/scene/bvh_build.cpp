@@ -339,7 +339,7 @@ class Collapser {
     if (decoded(o, e, qlo) > lo || decoded(o, e, qhi) < hi) {
       throw std::logic_error("a BVH child box does not fit its node's grid");
     }
-    const int word = 2 * k + (slot >> 2), shift = 8 * (slot & 3);
+    const int word = kGridWords * k + (slot >> 2), shift = 8 * (slot & 3);
     n.lo[word] |= static_cast<uint32_t>(qlo) << shift;
     n.hi[word] |= static_cast<uint32_t>(qhi) << shift;
   }

@@ -12,7 +12,14 @@
 
 namespace wt {
 
-constexpr int kBvhWidth = 8;
+// The node width: 8, or 4 where WAVETRACE_BVH_WIDTH says so (a build option, for
+// measuring the two against each other).
+#ifndef WAVETRACE_BVH_WIDTH
+#define WAVETRACE_BVH_WIDTH 8
+#endif
+constexpr int kBvhWidth = WAVETRACE_BVH_WIDTH;
+static_assert(kBvhWidth == 4 || kBvhWidth == 8, "the node width is 4 or 8");
+constexpr int kGridWords = kBvhWidth / 4;  // packed grid values per axis and side
 
 // A child reference: >= 0 is an inner node's index in the node array; < 0 is a leaf,
 // `count` primitives (1 to kMaxLeafCount) from `first` (below kMaxLeafFirst).
@@ -42,16 +49,16 @@ WT_HD WT_INLINE constexpr int leaf_count(int32_t ref) {
 struct alignas(32) WideBvhNode {
   float origin[3];
   uint32_t meta;  // bytes 0-2: each axis's grid exponent, biased by 127; byte 3: the child count
-  uint32_t lo[6];
-  uint32_t hi[6];
+  uint32_t lo[3 * kGridWords];
+  uint32_t hi[3 * kGridWords];
   int32_t child[kBvhWidth];  // slots 0 .. child_count - 1 in use
 
   WT_HD int child_count() const { return static_cast<int>(meta >> 24); }
   WT_HD uint32_t exponent(int axis) const { return (meta >> (8 * axis)) & 255u; }
-  WT_HD uint32_t grid_lo(int axis, int slot) const { return (lo[2 * axis + (slot >> 2)] >> (8 * (slot & 3))) & 255u; }
-  WT_HD uint32_t grid_hi(int axis, int slot) const { return (hi[2 * axis + (slot >> 2)] >> (8 * (slot & 3))) & 255u; }
+  WT_HD uint32_t grid_lo(int axis, int slot) const { return (lo[kGridWords * axis + (slot >> 2)] >> (8 * (slot & 3))) & 255u; }
+  WT_HD uint32_t grid_hi(int axis, int slot) const { return (hi[kGridWords * axis + (slot >> 2)] >> (8 * (slot & 3))) & 255u; }
 };
-static_assert(sizeof(WideBvhNode) == 96, "a node is three 32-byte sectors");
+static_assert(sizeof(WideBvhNode) == (kBvhWidth == 8 ? 96 : 64), "a node is three (two) 32-byte sectors");
 
 WT_HD WT_INLINE float bits_float(uint32_t bits) {
 #ifdef __CUDA_ARCH__

@@ -62,19 +62,25 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
   }
 }
 
-// Sorts eight keys ascending (a 19-comparator network).
-WT_HD WT_INLINE void sort8(uint32_t (&k)[kBvhWidth]) {
+// Sorts a node's keys ascending (a 19-comparator network for eight, 5 for four).
+WT_HD WT_INLINE void sort_keys(uint32_t (&k)[kBvhWidth]) {
   auto cx = [&k](int i, int j) {
     const uint32_t a = k[i], b = k[j];
     k[i] = a < b ? a : b;
     k[j] = a < b ? b : a;
   };
-  cx(0, 2), cx(1, 3), cx(4, 6), cx(5, 7);
-  cx(0, 4), cx(1, 5), cx(2, 6), cx(3, 7);
-  cx(0, 1), cx(2, 3), cx(4, 5), cx(6, 7);
-  cx(2, 4), cx(3, 5);
-  cx(1, 4), cx(3, 6);
-  cx(1, 2), cx(3, 4), cx(5, 6);
+  if constexpr (kBvhWidth == 8) {
+    cx(0, 2), cx(1, 3), cx(4, 6), cx(5, 7);
+    cx(0, 4), cx(1, 5), cx(2, 6), cx(3, 7);
+    cx(0, 1), cx(2, 3), cx(4, 5), cx(6, 7);
+    cx(2, 4), cx(3, 5);
+    cx(1, 4), cx(3, 6);
+    cx(1, 2), cx(3, 4), cx(5, 6);
+  } else {
+    cx(0, 1), cx(2, 3);
+    cx(0, 2), cx(1, 3);
+    cx(1, 2);
+  }
 }
 
 // The children of `n` that the ray enters before tmax, nearest first: slot + 1 in
@@ -86,7 +92,7 @@ WT_HD WT_INLINE void sort8(uint32_t (&k)[kBvhWidth]) {
 WT_HD WT_INLINE uint32_t children_in_order(const WideBvhNode& n, const vec3& o, const vec3& inv, float tmax,
                                            float& second) {
   float a[3] = {}, b_near[3] = {}, b_far[3] = {};
-  uint32_t near_words[6], far_words[6];
+  uint32_t near_words[3 * kGridWords], far_words[3 * kGridWords];
   WT_UNROLL
   for (int k = 0; k < 3; ++k) {
     const float step = grid_step(n.exponent(k));
@@ -98,7 +104,7 @@ WT_HD WT_INLINE uint32_t children_in_order(const WideBvhNode& n, const vec3& o, 
     b_far[k] = b + widen;
     const bool forward = inv[k] >= 0.0f;
     WT_UNROLL
-    for (int w = 2 * k; w < 2 * k + 2; ++w) {
+    for (int w = kGridWords * k; w < kGridWords * (k + 1); ++w) {
       near_words[w] = forward ? n.lo[w] : n.hi[w];
       far_words[w] = forward ? n.hi[w] : n.lo[w];
     }
@@ -111,15 +117,15 @@ WT_HD WT_INLINE uint32_t children_in_order(const WideBvhNode& n, const vec3& o, 
     float t_near[3], t_far[3];
     WT_UNROLL
     for (int k = 0; k < 3; ++k) {
-      t_near[k] = grid_value(near_words[2 * k + (s >> 2)], s & 3) * a[k] + b_near[k];
-      t_far[k] = grid_value(far_words[2 * k + (s >> 2)], s & 3) * a[k] + b_far[k];
+      t_near[k] = grid_value(near_words[kGridWords * k + (s >> 2)], s & 3) * a[k] + b_near[k];
+      t_far[k] = grid_value(far_words[kGridWords * k + (s >> 2)], s & 3) * a[k] + b_far[k];
     }
     const float enter = fmaxf(fmaxf(t_near[0], t_near[1]), fmaxf(t_near[2], 0.0f));
     const float leave = fminf(fminf(t_far[0], t_far[1]), fminf(t_far[2], tmax));
     const bool entered = s < n.child_count() && enter <= leave;
     key[s] = entered ? (float_bits(enter) & 0x7FFFFFF8u) | static_cast<uint32_t>(s) : 0xFFFFFFFFu;
   }
-  sort8(key);
+  sort_keys(key);
   second = bits_float(key[1] & 0x7FFFFFF8u);  // the slot's bits cleared: no larger than the distance
   uint32_t order = 0;
   WT_UNROLL
