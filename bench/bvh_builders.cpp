@@ -194,28 +194,16 @@ struct TraceCounts {
 
 constexpr float kTMax = 1e30f;
 
-// Closest hit through a binary tree: the nearer child first, the farther one
-// deferred with its entry distance. The builders are compared on the binary trees
-// they build, before scene_bvh.cpp collapses ours into the wide layout. The stack
+// Closest hit as geometry.hpp's intersect_closest walks one bottom level: the
+// nearer child first, the farther one deferred with its entry distance. The stack
 // here is deep enough for any tree, so that a tree deeper than the renderer's
 // stack still gives the right answer (its depth is reported).
-// The slab test: the entry distance, or a value > tmax when the box is missed.
-float entry(const BvhNode& n, const vec3& o, const vec3& inv, float tmax) {
-  float enter = 0.0f, leave = tmax;
-  for (int k = 0; k < 3; ++k) {
-    const float t0 = (n.lo[k] - o[k]) * inv[k], t1 = (n.hi[k] - o[k]) * inv[k];
-    enter = std::max(enter, std::min(t0, t1));
-    leave = std::min(leave, std::max(t0, t1) * 1.0000004f);
-  }
-  return enter <= leave ? enter : tmax * 2.0f + 1.0f;
-}
-
 TraceCounts trace(const BvhTree& tree, const std::vector<TriangleGeom>& tris, const vec3& o, const vec3& d) {
   TraceCounts c;
   c.t = kTMax;
   const vec3 inv(1.0f / d.x, 1.0f / d.y, 1.0f / d.z);
   const TriangleRay tr = triangle_ray(d);
-  if (entry(tree.nodes[0], o, inv, c.t) > c.t) return c;
+  if (box_entry(tree.nodes[0], o, inv, c.t) > c.t) return c;
   int stack[256];
   float stack_t[256];
   int top = 0, node = 0;
@@ -230,7 +218,7 @@ TraceCounts trace(const BvhTree& tree, const std::vector<TriangleGeom>& tris, co
       }
     } else {
       int a = n.left_or_first, b = a + 1;
-      float ta = entry(tree.nodes[a], o, inv, c.t), tb = entry(tree.nodes[b], o, inv, c.t);
+      float ta = box_entry(tree.nodes[a], o, inv, c.t), tb = box_entry(tree.nodes[b], o, inv, c.t);
       if (ta > tb) std::swap(ta, tb), std::swap(a, b);
       if (ta <= c.t) {
         if (tb <= c.t) stack[top] = b, stack_t[top++] = tb;

@@ -14,10 +14,7 @@ namespace wt {
 namespace {
 
 using test::box_contains;
-using test::expect_boxes_hold_primitives;
-using test::for_each_leaf;
 using test::walk;
-using test::wide_depth;
 
 struct SphereSet {
   std::string name;
@@ -134,6 +131,11 @@ std::vector<RayCase> random_rays(uint32_t seed, const std::vector<SphereGeom>& s
   return out;
 }
 
+int depth_below(const std::vector<BvhNode>& nodes, int node) {
+  if (nodes[node].count > 0) return 0;
+  int left = nodes[node].left_or_first;
+  return 1 + std::max(depth_below(nodes, left), depth_below(nodes, left + 1));
+}
 
 
 TEST(Bvh, ClosestHitMatchesBruteForce) {
@@ -163,9 +165,11 @@ TEST(Bvh, EverySphereIsInExactlyOneLeafOfAtMostFour) {
     Scene scene = built(set.spheres);
     ASSERT_EQ(scene.spheres.size(), set.spheres.size());
     std::vector<int> seen(scene.spheres.size(), 0);
-    for_each_leaf(scene.nodes, sphere_root(scene), [&](int first, int count, const Aabb&) {
-      EXPECT_LE(count, 4);
-      for (int i = first; i < first + count; ++i) ++seen[i];
+    walk(scene.nodes, sphere_root(scene), [&](int node, int) {
+      const BvhNode& n = scene.nodes[node];
+      if (n.count == 0) return;
+      EXPECT_LE(n.count, 4);
+      for (int i = n.left_or_first; i < n.left_or_first + n.count; ++i) ++seen[i];
     });
     for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "sphere " << i;
     // And the reordering is a permutation that moved each sphere with its material.
@@ -199,15 +203,15 @@ TEST(Bvh, NodeBoundsContainTheirChildrenAndSpheres) {
   for (const SphereSet& set : sphere_sets()) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
-    expect_boxes_hold_primitives(scene.nodes, sphere_root(scene), [&](int i) {
-      const SphereGeom& s = scene.spheres[i];
-      return Aabb{vec3(s.x, s.y, s.z) - vec3(s.w), vec3(s.x, s.y, s.z) + vec3(s.w)};
-    });
-    for_each_leaf(scene.nodes, sphere_root(scene), [&](int first, int count, const Aabb& box) {
-      for (int i = first; i < first + count; ++i) {
+    walk(scene.nodes, sphere_root(scene), [&](int node, int parent) {
+      const BvhNode& n = scene.nodes[node];
+      if (parent >= 0) {
+        EXPECT_TRUE(box_contains(scene.nodes[parent], n)) << "node " << node;
+      }
+      for (int i = n.left_or_first; n.count > 0 && i < n.left_or_first + n.count; ++i) {
         const SphereGeom& s = scene.spheres[i];
         const vec3 c(s.x, s.y, s.z);
-        EXPECT_TRUE(box_contains(box, c - vec3(s.w), c + vec3(s.w))) << "sphere " << i;
+        EXPECT_TRUE(box_contains(n, c - vec3(s.w), c + vec3(s.w))) << "sphere " << i;
       }
     });
   }
@@ -219,17 +223,17 @@ TEST(Bvh, DepthStaysBelowTheTraversalStack) {
   for (const SphereSet& set : sets) {
     SCOPED_TRACE(set.name);
     Scene scene = built(set.spheres);
-    EXPECT_LE(wide_depth(scene.nodes, sphere_root(scene)), kMaxBvhDepth);
+    EXPECT_LE(depth_below(scene.nodes, sphere_root(scene)), kMaxBvhDepth);
   }
 }
 
 TEST(Bvh, OneSphereSceneIsALeafUnderTheTopLevelsLeaf) {
   Scene scene = built({SphereGeom{1, 2, 3, 0.5f}});
   ASSERT_EQ(scene.nodes.size(), 2u);
-  for (const WideBvhNode& n : scene.nodes) {  // the one instance, then the one sphere
-    ASSERT_EQ(n.child_count(), 1);
-    EXPECT_EQ(n.child[0], leaf_ref(0, 1));
-  }
+  EXPECT_EQ(scene.nodes[0].count, 1);  // the one instance
+  EXPECT_EQ(scene.nodes[0].left_or_first, 0);
+  EXPECT_EQ(scene.nodes[1].count, 1);  // the one sphere
+  EXPECT_EQ(scene.nodes[1].left_or_first, 0);
   std::vector<ImageView> images;
   Hit h = intersect_closest(host_view(scene, 64, 64, images), Ray{vec3(1, 2, 0), vec3(0, 0, 1)}, kRayTMax);
   EXPECT_EQ(h.instance, 0);
@@ -239,11 +243,12 @@ TEST(Bvh, OneSphereSceneIsALeafUnderTheTopLevelsLeaf) {
 
 TEST(Bvh, GroundSphereIsIsolatedBelowTheRoot) {
   Scene scene = built(ground_and_marbles(7));
-  const WideBvhNode& root = scene.nodes[sphere_root(scene)];
+  const BvhNode& root = scene.nodes[sphere_root(scene)];
+  ASSERT_EQ(root.count, 0);
   int ground_leaf = -1;
-  for (int s = 0; s < root.child_count(); ++s) {
-    const int32_t c = root.child[s];
-    if (is_leaf(c) && leaf_count(c) == 1 && scene.sphere_material[leaf_first(c)] == 0) ground_leaf = s;
+  for (int child : {root.left_or_first, root.left_or_first + 1}) {
+    const BvhNode& n = scene.nodes[child];
+    if (n.count == 1 && scene.sphere_material[n.left_or_first] == 0) ground_leaf = child;
   }
   EXPECT_GE(ground_leaf, 0) << "the radius-1000 sphere should be a child leaf of the root, alone";
 }

@@ -19,8 +19,6 @@ namespace wt {
 namespace {
 
 using test::box_contains;
-using test::expect_boxes_hold_primitives;
-using test::for_each_leaf;
 using test::walk;
 
 // A hit as brute force sees it: which placement, which triangle (an index into the
@@ -322,9 +320,11 @@ TEST(MeshBvh, EveryTriangleIsInExactlyOneLeafOfItsMeshsTree) {
   std::vector<int> seen(s.triangles.size(), 0);
   for (size_t m = 0; m < s.meshes.size(); ++m) {
     const SceneMesh& mesh = s.meshes[m];
-    for_each_leaf(s.nodes, roots[m], [&](int first, int count, const Aabb&) {
-      EXPECT_LE(count, 4);
-      for (int i = first; i < first + count; ++i) {
+    walk(s.nodes, roots[m], [&](int node, int) {
+      const BvhNode& n = s.nodes[node];
+      if (n.count == 0) return;
+      EXPECT_LE(n.count, 4);
+      for (int i = n.left_or_first; i < n.left_or_first + n.count; ++i) {
         ASSERT_GE(i, static_cast<int>(mesh.first_triangle)) << "mesh " << m;
         ASSERT_LT(i, static_cast<int>(mesh.first_triangle + mesh.triangle_count)) << "mesh " << m;
         ++seen[i];
@@ -346,17 +346,18 @@ TEST(MeshBvh, NodeBoundsContainTheirChildrenAndTriangles) {
   const std::vector<int> roots = mesh_roots(s);
   int leaves = 0;
   for (int root : roots) {
-    expect_boxes_hold_primitives(s.nodes, root, [&](int i) {
-      Aabb b;
-      for (int c = 0; c < 3; ++c) b.grow(s.triangles[i].corner(c));
-      return b;
-    });
-    for_each_leaf(s.nodes, root, [&](int first, int count, const Aabb& box) {
+    walk(s.nodes, root, [&](int node, int parent) {
+      const BvhNode& n = s.nodes[node];
+      if (parent >= 0) {
+        EXPECT_TRUE(box_contains(s.nodes[parent], n))
+            << "node " << node;
+      }
+      if (n.count == 0) return;
       ++leaves;
-      for (int i = first; i < first + count; ++i) {
+      for (int i = n.left_or_first; i < n.left_or_first + n.count; ++i) {
         for (int c = 0; c < 3; ++c) {
           const vec3 p = s.triangles[i].corner(c);
-          EXPECT_TRUE(box_contains(box, p, p)) << "triangle " << i << " corner " << c;
+          EXPECT_TRUE(box_contains(n, p, p)) << "triangle " << i << " corner " << c;
         }
       }
     });
@@ -370,27 +371,31 @@ TEST(MeshBvh, NodeBoundsContainTheirChildrenAndTriangles) {
 TEST(MeshBvh, TopLevelHoldsEachInstanceOnceInsideItsBounds) {
   const Scene s = three_meshes_placed_twice();
   std::vector<int> seen(s.instances.size(), 0);
-  // An instance's world box: the corners of its mesh's triangles' box through the
-  // transform.
-  auto world_box = [&](int i) {
-    const Instance& in = s.instances.at(i);
-    const SceneMesh& mesh = s.meshes.at(in.material / 2);
-    Aabb object, world;
-    for (uint32_t t = mesh.first_triangle; t < mesh.first_triangle + mesh.triangle_count; ++t) {
-      for (int c = 0; c < 3; ++c) object.grow(s.triangles[t].corner(c));
+  std::vector<std::pair<int, int>> todo = {{0, -1}};
+  while (!todo.empty()) {
+    auto [node, parent] = todo.back();
+    todo.pop_back();
+    const BvhNode& n = s.nodes[node];
+    if (parent >= 0) {
+      EXPECT_TRUE(box_contains(s.nodes[parent], n))
+          << "node " << node;
     }
+    if (n.count == 0) {
+      todo.push_back({n.left_or_first, node});
+      todo.push_back({n.left_or_first + 1, node});
+      continue;
+    }
+    ASSERT_EQ(n.count, 1);
+    const Instance& in = s.instances.at(n.left_or_first);
+    ++seen[n.left_or_first];
+    const BvhNode& root = s.nodes[in.root];
     for (int corner = 0; corner < 8; ++corner) {
-      world.grow(in.world_from_object.point(vec3((corner & 1) ? object.hi.x : object.lo.x,
-                                                 (corner & 2) ? object.hi.y : object.lo.y,
-                                                 (corner & 4) ? object.hi.z : object.lo.z)));
+      const vec3 c((corner & 1) ? root.hi[0] : root.lo[0], (corner & 2) ? root.hi[1] : root.lo[1],
+                   (corner & 4) ? root.hi[2] : root.lo[2]);
+      const vec3 w = in.world_from_object.point(c);
+      EXPECT_TRUE(box_contains(n, w, w)) << "instance " << n.left_or_first << " corner " << corner;
     }
-    return world;
-  };
-  expect_boxes_hold_primitives(s.nodes, 0, world_box);
-  for_each_leaf(s.nodes, 0, [&](int first, int count, const Aabb&) {
-    ASSERT_EQ(count, 1);
-    ++seen[first];
-  });
+  }
   for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "instance " << i;
   EXPECT_EQ(seen.size(), 6u);
 }

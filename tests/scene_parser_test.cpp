@@ -223,8 +223,8 @@ TEST(SceneParser, OmittedFieldsTakeTheDocumentedDefaults) {
   EXPECT_EQ(s.materials[2].albedo, vec3(1.0f));
   EXPECT_EQ(s.materials[2].fuzz, 0.0f);
   ASSERT_EQ(s.nodes.size(), 2u);  // one sphere: the top level's leaf, over the spheres' leaf
-  EXPECT_EQ(s.nodes[0].child[0], leaf_ref(0, 1));
-  EXPECT_EQ(s.nodes[1].child[0], leaf_ref(0, 1));
+  EXPECT_EQ(s.nodes[0].count, 1);
+  EXPECT_EQ(s.nodes[1].count, 1);
 }
 
 TEST(SceneParser, UniformSkyUsesItsRadianceEverywhere) {

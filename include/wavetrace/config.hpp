@@ -6,11 +6,9 @@
 #if defined(__CUDACC__)
 #define WT_HD __host__ __device__
 #define WT_INLINE __forceinline__
-#define WT_UNROLL _Pragma("unroll")
 #else
 #define WT_HD
 #define WT_INLINE inline
-#define WT_UNROLL
 #endif
 
 // GLM's defaulted special members trigger nvcc diagnostic 20012 ("__host__ annotation

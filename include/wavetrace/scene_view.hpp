@@ -22,7 +22,7 @@ struct RenderParams {
 // the CPU). The constant-memory megakernel has an accessor of the same shape.
 // The accessor functions are the ones geometry/geometry.hpp names.
 struct SceneView {
-  const WideBvhNode* nodes;  // the top level over instances first, then each instance's
+  const BvhNode* nodes;  // the top level over instances first, then each instance's
   const Instance* instances;
   const SphereGeom* spheres;
   const uint32_t* sphere_materials;
@@ -40,45 +40,7 @@ struct SceneView {
   Camera camera;
 
   WT_HD int node_count() const { return node_total; }
-  // A node in 16-byte loads through the read-only cache on the GPU, each word put
-  // in its field (a copy through a cast pointer would place the node in local
-  // memory).
-  WT_HD WideBvhNode node(int i) const {
-#ifdef __CUDA_ARCH__
-    constexpr int kLoads = sizeof(WideBvhNode) / 16;
-    const int4* from = reinterpret_cast<const int4*>(nodes + i);
-    uint32_t words[4 * kLoads];
-    WT_UNROLL
-    for (int k = 0; k < kLoads; ++k) {
-      const int4 v = __ldg(from + k);
-      words[4 * k] = static_cast<uint32_t>(v.x);
-      words[4 * k + 1] = static_cast<uint32_t>(v.y);
-      words[4 * k + 2] = static_cast<uint32_t>(v.z);
-      words[4 * k + 3] = static_cast<uint32_t>(v.w);
-    }
-    WideBvhNode n;
-    WT_UNROLL
-    for (int k = 0; k < 3; ++k) n.origin[k] = __uint_as_float(words[k]);
-    n.meta = words[3];
-    WT_UNROLL
-    for (int k = 0; k < 3 * kGridWords; ++k) {
-      n.lo[k] = words[4 + k];
-      n.hi[k] = words[4 + 3 * kGridWords + k];
-    }
-    WT_UNROLL
-    for (int k = 0; k < kBvhWidth; ++k) n.child[k] = static_cast<int32_t>(words[4 + 6 * kGridWords + k]);
-    return n;
-#else
-    return nodes[i];
-#endif
-  }
-  WT_HD int32_t node_child(int i, int slot) const {
-#ifdef __CUDA_ARCH__
-    return __ldg(&nodes[i].child[slot]);
-#else
-    return nodes[i].child[slot];
-#endif
-  }
+  WT_HD BvhNode node(int i) const { return nodes[i]; }
   WT_HD const Instance& instance(int i) const { return instances[i]; }
   WT_HD SphereGeom sphere(int i) const { return spheres[i]; }
   WT_HD uint32_t sphere_material(int i) const { return sphere_materials[i]; }

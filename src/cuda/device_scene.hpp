@@ -21,7 +21,7 @@ class DeviceScene {
   const std::vector<ImageView>& image_views() const { return image_views_; }
 
  private:
-  DeviceBuffer<WideBvhNode> nodes_;
+  DeviceBuffer<BvhNode> nodes_;
   DeviceBuffer<Instance> instances_;
   DeviceBuffer<SphereGeom> spheres_;
   DeviceBuffer<uint32_t> sphere_material_;

@@ -14,7 +14,7 @@ namespace {
 
 // The 64 KiB of constant memory, less headroom for what the toolchain places there.
 constexpr size_t kPoolBytes = 63 * 1024;
-__constant__ __align__(32) unsigned char c_pool[kPoolBytes];
+__constant__ __align__(16) unsigned char c_pool[kPoolBytes];
 
 // Where each array starts in the pool.
 struct ConstantLayout {
@@ -33,8 +33,7 @@ struct ConstantScene {
     return reinterpret_cast<const T*>(c_pool + offset);
   }
   __device__ int node_count() const { return layout.node_total; }
-  __device__ WideBvhNode node(int i) const { return array<WideBvhNode>(layout.nodes)[i]; }
-  __device__ int32_t node_child(int i, int slot) const { return array<WideBvhNode>(layout.nodes)[i].child[slot]; }
+  __device__ BvhNode node(int i) const { return array<BvhNode>(layout.nodes)[i]; }
   __device__ const Instance& instance(int i) const { return array<Instance>(layout.instances)[i]; }
   __device__ SphereGeom sphere(int i) const { return array<SphereGeom>(layout.spheres)[i]; }
   __device__ uint32_t sphere_material(int i) const { return array<uint32_t>(layout.sphere_materials)[i]; }

@@ -1,6 +1,6 @@
-// The BVH builder: a binned-SAH binary tree over boxes, collapsed into the wide
-// node layout that include/wavetrace/geometry/bvh.hpp traverses. It knows nothing
-// of what the boxes bound: spheres, triangles and instances are all built by it.
+// The BVH builder: a binned-SAH tree over boxes, in the node layout that
+// include/wavetrace/geometry/bvh.hpp traverses. It knows nothing of what the boxes
+// bound: spheres, triangles and instances are all built by it.
 #pragma once
 
 #include <cfloat>
@@ -10,16 +10,6 @@
 #include "wavetrace/geometry/bvh.hpp"
 
 namespace wt {
-
-// The binary tree as built: two 16-byte rows, the bounds and either the first of two
-// adjacent children (inner node, count == 0) or the first primitive and the
-// primitive count (leaf).
-struct alignas(16) BvhNode {
-  float lo[3];
-  int32_t left_or_first;
-  float hi[3];
-  int32_t count;
-};
 
 struct Aabb {
   vec3 lo{FLT_MAX};
@@ -81,20 +71,5 @@ struct BvhStats {
   double sah_cost = 0;
 };
 BvhStats bvh_stats(const std::vector<BvhNode>& nodes, const BvhBuildOptions& options = {});
-// The same of the wide tree under `root` (a node a ray visits costs the options'
-// traversal cost once, whatever its width).
-BvhStats bvh_stats(const std::vector<WideBvhNode>& nodes, int32_t root, const BvhBuildOptions& options = {});
-
-// Collapses a binary tree into wide nodes appended to `out` (each wide node takes
-// the binary nodes of largest area below it until it has kBvhWidth children) and
-// returns the root's index. The root is always an inner node, even over a single
-// leaf. Leaves' primitive indices move by `first_prim`. Throws std::length_error
-// when a leaf's primitives are out of the layout's reach.
-int32_t append_wide(std::vector<WideBvhNode>& out, const std::vector<BvhNode>& tree, uint32_t first_prim);
-
-// A wide node's box: the union of its children's decoded boxes.
-Aabb wide_bounds(const WideBvhNode& n);
-// A child's decoded box.
-Aabb child_bounds(const WideBvhNode& n, int slot);
 
 }  // namespace wt

@@ -92,7 +92,7 @@ struct Scene {
   // Built from the above by build_bvh: the instances in top-level order and the
   // node array (the top level first, then the spheres' and each mesh's tree).
   std::vector<Instance> instances;
-  std::vector<WideBvhNode> nodes;
+  std::vector<BvhNode> nodes;
   BvhStats top_level_bvh;
   BvhStats sphere_bvh;
   LoadTimes load_times;

@@ -43,6 +43,17 @@ void permute_range(std::vector<T>& v, size_t first, const std::vector<uint32_t>&
   std::copy(out.begin(), out.end(), v.begin() + first);
 }
 
+// Appends a bottom-level tree to the node array; its leaves' primitive indices move
+// by `first_prim`. Returns the root's index.
+int32_t append_tree(std::vector<BvhNode>& nodes, const std::vector<BvhNode>& tree, uint32_t first_prim) {
+  const int32_t base = static_cast<int32_t>(nodes.size());
+  for (BvhNode n : tree) {
+    n.left_or_first += n.count > 0 ? static_cast<int32_t>(first_prim) : base;
+    nodes.push_back(n);
+  }
+  return base;
+}
+
 // The world box of an instance: its tree's root box through the transform, widened
 // by the rounding of the transform (rays are carried the other way, into object
 // space, and must not be culled here where they hit there).
@@ -83,6 +94,7 @@ void build_bvh(Scene& scene) {
     }
     permute_range(scene.spheres, 0, tree.order);
     permute_range(scene.sphere_material, 0, tree.order);
+    scene.sphere_bvh = bvh_stats(tree.nodes, blas_options);
     sphere_tree = std::move(tree.nodes);
   }
   std::vector<std::vector<BvhNode>> mesh_trees(scene.meshes.size());
@@ -101,6 +113,7 @@ void build_bvh(Scene& scene) {
     permute_range(scene.triangles, mesh.first_triangle, tree.order);
     permute_range(scene.triangle_shading, mesh.first_triangle, tree.order);
     permute_range(scene.triangle_material, mesh.first_triangle, tree.order);
+    mesh.bvh = bvh_stats(tree.nodes, blas_options);
     mesh_trees[m] = std::move(tree.nodes);
   }
 
@@ -118,22 +131,12 @@ void build_bvh(Scene& scene) {
   } catch (const std::length_error& e) {
     throw SceneError(scene.source + ": /instances: " + e.what());
   }
-  // Every tree collapsed into the wide layout, the top level first (at node 0).
-  int32_t sphere_root = -1;
+  scene.top_level_bvh = bvh_stats(top.nodes, tlas_options);
+  scene.nodes = std::move(top.nodes);
+  const int32_t sphere_root = sphere_tree.empty() ? -1 : append_tree(scene.nodes, sphere_tree, 0);
   std::vector<int32_t> mesh_roots(scene.meshes.size());
-  try {
-    append_wide(scene.nodes, top.nodes, 0);
-    scene.top_level_bvh = bvh_stats(scene.nodes, 0, tlas_options);
-    if (!sphere_tree.empty()) {
-      sphere_root = append_wide(scene.nodes, sphere_tree, 0);
-      scene.sphere_bvh = bvh_stats(scene.nodes, sphere_root, blas_options);
-    }
-    for (size_t m = 0; m < scene.meshes.size(); ++m) {
-      mesh_roots[m] = append_wide(scene.nodes, mesh_trees[m], scene.meshes[m].first_triangle);
-      scene.meshes[m].bvh = bvh_stats(scene.nodes, mesh_roots[m], blas_options);
-    }
-  } catch (const std::length_error& e) {
-    throw SceneError(scene.source + ": " + e.what());
+  for (size_t m = 0; m < scene.meshes.size(); ++m) {
+    mesh_roots[m] = append_tree(scene.nodes, mesh_trees[m], scene.meshes[m].first_triangle);
   }
   if (scene.nodes.size() > static_cast<size_t>(INT32_MAX)) {
     throw SceneError(scene.source + ": too many BVH nodes for 32-bit indices");

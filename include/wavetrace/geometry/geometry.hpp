@@ -4,7 +4,7 @@
 // switch here, and its bounds in the host's scene builder; no kernel changes.
 //
 // The scene accessor `g` (SceneView, or the constant-memory scene) provides
-// node_count(), node(i), node_child(i, slot), instance(i), sphere(i), sphere_material(i), triangle(i),
+// node_count(), node(i), instance(i), sphere(i), sphere_material(i), triangle(i),
 // triangle_shading(i), triangle_material(i), normal(i) and uv(i).
 #pragma once
 
@@ -62,91 +62,16 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
   }
 }
 
-// Sorts a node's keys ascending (a 19-comparator network for eight, 5 for four).
-WT_HD WT_INLINE void sort_keys(uint32_t (&k)[kBvhWidth]) {
-  auto cx = [&k](int i, int j) {
-    const uint32_t a = k[i], b = k[j];
-    k[i] = a < b ? a : b;
-    k[j] = a < b ? b : a;
-  };
-  if constexpr (kBvhWidth == 8) {
-    cx(0, 2), cx(1, 3), cx(4, 6), cx(5, 7);
-    cx(0, 4), cx(1, 5), cx(2, 6), cx(3, 7);
-    cx(0, 1), cx(2, 3), cx(4, 5), cx(6, 7);
-    cx(2, 4), cx(3, 5);
-    cx(1, 4), cx(3, 6);
-    cx(1, 2), cx(3, 4), cx(5, 6);
-  } else {
-    cx(0, 1), cx(2, 3);
-    cx(0, 2), cx(1, 3);
-    cx(1, 2);
-  }
-}
-
-// The children of `n` that the ray enters before tmax, nearest first: slot + 1 in
-// each 4-bit field from the lowest up, 0 after the last (0 when none is entered).
-// `second`: a lower bound of the second child's entry distance, and so of every
-// child after the first.
-// The slab distances come from per-node terms, widened by kSlabWidening (bvh.hpp);
-// on each axis the ray's sign picks which grid value is the near side.
-WT_HD WT_INLINE uint32_t children_in_order(const WideBvhNode& n, const vec3& o, const vec3& inv, float tmax,
-                                           float& second) {
-  float a[3] = {}, b_near[3] = {}, b_far[3] = {};
-  uint32_t near_words[3 * kGridWords], far_words[3 * kGridWords];
-  WT_UNROLL
-  for (int k = 0; k < 3; ++k) {
-    const float step = grid_step(n.exponent(k));
-    const float rel = n.origin[k] - o[k];
-    a[k] = step * inv[k];
-    const float b = rel * inv[k];
-    const float widen = (255.0f * step + fabsf(rel)) * fabsf(inv[k]) * kSlabWidening;
-    b_near[k] = b - widen;
-    b_far[k] = b + widen;
-    const bool forward = inv[k] >= 0.0f;
-    WT_UNROLL
-    for (int w = kGridWords * k; w < kGridWords * (k + 1); ++w) {
-      near_words[w] = forward ? n.lo[w] : n.hi[w];
-      far_words[w] = forward ? n.hi[w] : n.lo[w];
-    }
-  }
-  // Each child's key: its entry distance's bits (non-negative, so they order as
-  // the distances do) with the slot in the lowest three; all ones when not entered.
-  uint32_t key[kBvhWidth];
-  WT_UNROLL
-  for (int s = 0; s < kBvhWidth; ++s) {
-    float t_near[3], t_far[3];
-    WT_UNROLL
-    for (int k = 0; k < 3; ++k) {
-      t_near[k] = grid_value(near_words[kGridWords * k + (s >> 2)], s & 3) * a[k] + b_near[k];
-      t_far[k] = grid_value(far_words[kGridWords * k + (s >> 2)], s & 3) * a[k] + b_far[k];
-    }
-    const float enter = fmaxf(fmaxf(t_near[0], t_near[1]), fmaxf(t_near[2], 0.0f));
-    const float leave = fminf(fminf(t_far[0], t_far[1]), fminf(t_far[2], tmax));
-    const bool entered = s < n.child_count() && enter <= leave;
-    key[s] = entered ? (float_bits(enter) & 0x7FFFFFF8u) | static_cast<uint32_t>(s) : 0xFFFFFFFFu;
-  }
-  sort_keys(key);
-  second = bits_float(key[1] & 0x7FFFFFF8u);  // the slot's bits cleared: no larger than the distance
-  uint32_t order = 0;
-  WT_UNROLL
-  for (int i = 0; i < kBvhWidth; ++i) {
-    if (key[i] != 0xFFFFFFFFu) order |= ((key[i] & 7u) + 1u) << (4 * i);
-  }
-  return order;
-}
-
-// The closest hit along `world` before tmax. A node's children are visited nearest
-// entry first; the rest wait on the stack as one entry (the node, the order of the
-// children left and a lower bound of their entry distances, which drops them all
-// once a hit is nearer), so the stack holds at most one entry per level. The top-level
-// BVH's leaves are single instances; entering one moves the ray into the instance's
-// object space (where t measures the same distances: the direction is transformed,
-// not renormalised) and pushes the mark of the way back.
+// The closest hit along `world` before tmax. The top-level BVH's leaves are single
+// instances; entering one moves the ray into the instance's object space (where t
+// measures the same distances: the direction is transformed, not renormalised) and
+// pushes the mark of the way back.
 template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   if (g.node_count() == 0) return hit;
-  // Only triangle instances are ever transformed (spheres stand untransformed).
+  // Only triangle instances are ever transformed (spheres stand untransformed), and
+  // only triangles need the slab test's round-up (spheres' boxes are padded).
   constexpr bool kTriangles = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
   Ray ray = world;
   vec3 inv = slab_inverse(world.dir);
@@ -154,31 +79,16 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   int instance = -1;
   PrimitiveKind kind = PrimitiveKind::Sphere;
   // Spheres alone stand in one instance: the top level is a single leaf, and the
-  // stack holds the return mark and one tree's deferred entries.
+  // stack holds the return mark and one tree's deferred nodes.
   constexpr int kStack = kTriangles ? kBvhStackSize : kMaxBvhDepth + 1;
-  int32_t stack_node[kStack];
-  uint32_t stack_order[kStack];
+  int stack[kStack];
   float stack_t[kStack];
   int top = 0;
-  int32_t ref = 0;  // the top level's root
+  int node = 0;
   for (;;) {
-    if (!is_leaf(ref)) {
-      const WideBvhNode n = g.node(ref);
-      float second;
-      uint32_t order = children_in_order(n, ray.origin, inv, hit.t, second);
-      if (order != 0) {
-        const int slot = static_cast<int>(order & 15u) - 1;
-        order >>= 4;
-        if (order != 0 && top < kStack) {
-          stack_node[top] = ref;
-          stack_order[top] = order;
-          stack_t[top++] = second;
-        }
-        ref = child_in_slot(n, slot);
-        continue;
-      }
-    } else if (instance < 0) {
-      instance = leaf_first(ref);
+    BvhNode n = g.node(node);
+    if (n.count > 0 && instance < 0) {
+      instance = n.left_or_first;
       const Instance& in = g.instance(instance);
       kind = in.kind;
       if (kTriangles && !in.identity) {
@@ -188,22 +98,40 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
       }
       if (kTriangles && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
       if (top < kStack) {
-        stack_node[top] = kReturnToWorld;
-        stack_order[top] = 0;
+        stack[top] = kReturnToWorld;
         stack_t[top++] = 0.0f;
       }
-      ref = in.root;
+      node = in.root;
       continue;
-    } else {
-      intersect_leaf<Kinds>(g, kind, instance, leaf_first(ref), leaf_count(ref), ray, tr, hit);
     }
-    // Pop: the nearest child left of the deepest deferred node, skipping nodes whose
-    // children all start beyond the closest hit so far.
+    if (n.count > 0) {
+      intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
+    } else {
+      int a = n.left_or_first, b = n.left_or_first + 1;
+      float ta = box_entry<kTriangles>(g.node(a), ray.origin, inv, hit.t);
+      float tb = box_entry<kTriangles>(g.node(b), ray.origin, inv, hit.t);
+      if (ta > tb) {
+        float tt = ta;
+        ta = tb;
+        tb = tt;
+        int ti = a;
+        a = b;
+        b = ti;
+      }
+      if (ta <= hit.t) {
+        if (tb <= hit.t && top < kStack) {
+          stack[top] = b;
+          stack_t[top++] = tb;
+        }
+        node = a;
+        continue;
+      }
+    }
+    // Pop, skipping nodes whose boxes the closest hit so far already passed.
     bool found = false;
     while (top > 0) {
-      const int32_t node = stack_node[top - 1];
-      if (node == kReturnToWorld) {
-        --top;
+      --top;
+      if (stack[top] == kReturnToWorld) {
         if (kTriangles) {
           ray = world;
           inv = slab_inverse(world.dir);
@@ -211,21 +139,11 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
         instance = -1;
         continue;
       }
-      if (stack_t[top - 1] > hit.t) {
-        --top;
-        continue;
+      if (stack_t[top] <= hit.t) {
+        node = stack[top];
+        found = true;
+        break;
       }
-      uint32_t order = stack_order[top - 1];
-      const int slot = static_cast<int>(order & 15u) - 1;
-      order >>= 4;
-      if (order == 0) {
-        --top;
-      } else {
-        stack_order[top - 1] = order;
-      }
-      ref = g.node_child(node, slot);
-      found = true;
-      break;
     }
     if (!found) break;
   }
