@@ -11,6 +11,7 @@
 #include <stb/stb_image_write.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -164,24 +165,24 @@ class ExrStream : public Imf::OStream {
   uint64_t position_ = 0;
 };
 
-// Channels R, G, B and A (= 1) of type T (half or float), ZIP-compressed, rows from the
-// top (the header's default line order).
+// Channels R, G, B and A (= 1) of type T (float or half), ZIP-compressed, rows from the
+// top (the header's default line order). `rgb` holds width * height * 3 values of T.
 template <typename T>
-void write_exr_pixels(Imf::OStream& stream, int w, int h, const std::vector<float>& rgb, Imf::PixelType type) {
-  const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(h);
-  std::vector<T> rgba(pixels * 4);
-  for (size_t i = 0; i < pixels; ++i) {
-    for (size_t c = 0; c < 3; ++c) rgba[i * 4 + c] = T(rgb[i * 3 + c]);
-    rgba[i * 4 + 3] = T(1.0f);
-  }
+void write_exr_pixels(Imf::OStream& stream, int w, int h, const T* rgb, Imf::PixelType type) {
   Imf::Header header(w, h);
   Imf::FrameBuffer frame;
-  const char* const names[] = {"R", "G", "B", "A"};
-  for (size_t c = 0; c < 4; ++c) {
+  const char* const names[] = {"R", "G", "B"};
+  // An output file only reads its frame buffer.
+  char* const base = const_cast<char*>(reinterpret_cast<const char*>(rgb));
+  for (size_t c = 0; c < 3; ++c) {
     header.channels().insert(names[c], Imf::Channel(type));
-    frame.insert(names[c], Imf::Slice(type, reinterpret_cast<char*>(rgba.data() + c), sizeof(T) * 4,
-                                      sizeof(T) * 4 * static_cast<size_t>(w)));
+    frame.insert(names[c],
+                 Imf::Slice(type, base + c * sizeof(T), sizeof(T) * 3, sizeof(T) * 3 * static_cast<size_t>(w)));
   }
+  // One row of ones serves every row (a row stride of 0).
+  std::vector<T> alpha(static_cast<size_t>(std::max(w, 0)), T(1.0f));
+  header.channels().insert("A", Imf::Channel(type));
+  frame.insert("A", Imf::Slice(type, reinterpret_cast<char*>(alpha.data()), sizeof(T), 0));
   Imf::OutputFile file(stream, header);  // its destructor writes the row offsets
   file.setFrameBuffer(frame);
   file.writePixels(h);
@@ -198,10 +199,11 @@ StagedFile stage_exr(const std::string& path, int w, int h, const std::vector<fl
   FileWriter f(path);
   try {
     ExrStream stream(f, path);
-    if (pixels == ExrPixels::Half) {
-      write_exr_pixels<half>(stream, w, h, rgb, Imf::HALF);
+    if (pixels == ExrPixels::Float) {
+      write_exr_pixels(stream, w, h, rgb.data(), Imf::FLOAT);  // the render's floats, in place
     } else {
-      write_exr_pixels<float>(stream, w, h, rgb, Imf::FLOAT);
+      const std::vector<half> rgb_half(rgb.begin(), rgb.end());  // rounded to nearest
+      write_exr_pixels(stream, w, h, rgb_half.data(), Imf::HALF);
     }
   } catch (const Iex::BaseExc& e) {
     // A failed write of the file's bytes is reported by finish(), with the system's
