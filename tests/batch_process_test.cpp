@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 auto fields(const Job& j) {
   return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
                   j.kernel, j.warmup, j.wave_size, j.threads, j.checkpoint, j.resume, j.checkpoint_every, j.encoding,
-                  j.progress, j.profile);
+                  j.exr_float, j.progress, j.profile);
 }
 
 // Parses a command line (after the program name) as main does.
@@ -62,6 +62,7 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   every.resume = "r.ckpt";
   every.checkpoint_every = 9;
   every.encoding = Encoding::Gamma2;
+  every.exr_float = true;
   every.progress = false;
   every.profile = true;
   Job defaults;
@@ -75,6 +76,12 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   }
   // A default job's settings stay unset, so that the scene's own apply.
   EXPECT_FALSE(parse_render({"render", "-o", "o.png", "s.json"}).width.has_value());
+}
+
+TEST(RenderCommand, ExrFloatIsAFlagThatIsOffByDefault) {
+  EXPECT_TRUE(parse_render({"render", "-o", "o.exr", "--exr-float", "s.json"}).exr_float);
+  EXPECT_FALSE(parse_render({"render", "-o", "o.exr", "s.json"}).exr_float);
+  EXPECT_THROW(parse_render({"render", "-o", "o.exr", "--exr-float=maybe", "s.json"}), CLI::ParseError);
 }
 
 class BatchProcessTest : public testing::Test {

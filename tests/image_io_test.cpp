@@ -1,6 +1,8 @@
 // PNG encoding round trip: the project's writer encodes, stb decodes, and each
-// 8-bit value is the one the transfer curve gives, at its pixel. Writes that fail
-// part way (a full disk) leave no file and no temporary file behind.
+// 8-bit value is the one the transfer curve gives, at its pixel. OpenEXR round trip:
+// OpenEXR's reader gets the linear values back, half-rounded or exact, at their
+// pixels. Writes that fail part way (a full disk) leave no file and no temporary file
+// behind.
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
 #include <unistd.h>
@@ -12,6 +14,7 @@
 #include <random>
 #include <vector>
 
+#include "exr_support.hpp"
 #include "image/image_io.hpp"
 #include "test_support.hpp"
 
@@ -55,6 +58,87 @@ TEST(PngRoundTrip, Gamma2IsTheSquareRoot) {
   const std::vector<float> rgb = {0.25f, 0.64f, 0.09f, 1.0f, 0.0f, 4.0f};
   const std::vector<unsigned char> expected = {128, 204, 77, 255, 0, 255};  // round(255 sqrt(v)), halves up
   EXPECT_EQ(round_trip(rgb, 1, 2, Encoding::Gamma2), expected);
+}
+
+// 12 pixels (4 x 3 or 3 x 4), no two alike and no pixel grey, so that a flipped,
+// mirrored or transposed image, or channels out of order, read back wrong. Values
+// that half floats round (0.1, 1/3, 1000.7, 0.7), one past their range (70000:
+// infinity), zero, negatives and ones below their normal range (1e-5).
+std::vector<float> asymmetric_image() {
+  std::vector<float> rgb(12 * 3);
+  const float values[] = {0.1f, 1.0f / 3.0f, 1000.7f, 70000.0f, 0.0f, -0.25f, 1e-5f, 2.5f, 0.7f};
+  for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = values[i % 9] * static_cast<float>(1 + i / 9);
+  return rgb;
+}
+
+class ExrRoundTrip : public testing::Test {
+ protected:
+
+  // Writes the image with `pixels` and reads it back, checking what every EXR written
+  // holds: its size, channels A, B, G, R (OpenEXR's order) of the one type, alpha 1.
+  test::ExrImage round_trip(const std::vector<float>& rgb, int width, int height, ExrPixels pixels,
+                            Imf::PixelType type) {
+    const std::string out = (dir_ / "out.exr").string();
+    write_image(out, width, height, rgb, Encoding::Srgb, pixels);
+    test::ExrImage image = test::read_exr(out);
+    EXPECT_EQ(image.width, width);
+    EXPECT_EQ(image.height, height);
+    EXPECT_EQ(image.channels, (std::vector<std::string>{"A", "B", "G", "R"}));
+    EXPECT_EQ(image.types, std::vector<Imf::PixelType>(4, type));
+    for (size_t i = 3; i < image.rgba.size(); i += 4) EXPECT_EQ(image.rgba[i], 1.0f) << "alpha of pixel " << i / 4;
+    return image;
+  }
+
+  // The image's RGB at (x, y), row 0 on top, and what was written there.
+  static void expect_pixels(const test::ExrImage& image, const std::vector<float>& expected, int width, int height) {
+    ASSERT_EQ(image.rgba.size(), static_cast<size_t>(width) * height * 4);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(image.rgba[(static_cast<size_t>(y) * width + x) * 4 + c],
+                    expected[(static_cast<size_t>(y) * width + x) * 3 + c])
+              << "x " << x << " y " << y << " channel " << c;
+        }
+      }
+    }
+  }
+
+  test::TestFolder folder_;
+  const fs::path dir_ = folder_.root();
+};
+
+TEST_F(ExrRoundTrip, HalfIsTheDefaultAndHoldsEachValueHalfRounded) {
+  const std::vector<float> rgb = asymmetric_image();
+  std::vector<float> expected(rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) expected[i] = test::half_rounded(rgb[i]);
+  const std::string out = (dir_ / "default.exr").string();
+  write_image(out, 4, 3, rgb, Encoding::Srgb);  // no pixel type given: half
+  EXPECT_EQ(test::read_exr(out).types, std::vector<Imf::PixelType>(4, Imf::HALF));
+  expect_pixels(round_trip(rgb, 4, 3, ExrPixels::Half, Imf::HALF), expected, 4, 3);
+}
+
+TEST_F(ExrRoundTrip, FloatHoldsEachValueExactly) {
+  const std::vector<float> rgb = asymmetric_image();
+  expect_pixels(round_trip(rgb, 4, 3, ExrPixels::Float, Imf::FLOAT), rgb, 4, 3);
+}
+
+TEST_F(ExrRoundTrip, TallImagesKeepTheirOrientationToo) {
+  const std::vector<float> rgb = asymmetric_image();  // now 3 wide, 4 tall
+  expect_pixels(round_trip(rgb, 3, 4, ExrPixels::Float, Imf::FLOAT), rgb, 3, 4);
+}
+
+TEST(OutputPath, ExrIsAnOutputFormatAndUnknownExtensionsAreNot) {
+  test::TestFolder folder;
+  const std::string dir = folder.root().string();
+  EXPECT_NO_THROW(check_output_path(dir + "/a.exr"));
+  EXPECT_NO_THROW(check_output_path(dir + "/a.EXR"));
+  try {
+    check_output_path(dir + "/a.tiff");
+    ADD_FAILURE() << "a .tiff output was accepted";
+  } catch (const OutputError& e) {
+    EXPECT_EQ(std::string(e.what()), dir + "/a.tiff: unknown output format '.tiff' (use .png, .pfm or .exr)");
+  }
+  EXPECT_THROW(check_output_path(dir + "/no-such-folder/a.exr"), OutputError);
 }
 
 // The write run in a child process whose files may not grow past `limit` bytes (a
@@ -109,6 +193,36 @@ TEST_F(FullDisk, PfmWriteFailsNamingTheFileAndLeavesNothing) {
   const std::string out = path("out.pfm");
   EXPECT_EQ(write_error_with_file_size_limit(20000, [&] { write_image(out, 64, 64, noise(), Encoding::Srgb); }),
             efbig(out));
+  EXPECT_EQ(files(), std::vector<std::string>{});
+}
+
+TEST_F(FullDisk, ExrWriteFailsNamingTheFileAndLeavesNothing) {
+  for (const ExrPixels pixels : {ExrPixels::Half, ExrPixels::Float}) {
+    const std::string out = path("out.exr");
+    EXPECT_EQ(write_error_with_file_size_limit(4096, [&] { write_image(out, 64, 64, noise(), Encoding::Srgb, pixels); }),
+              efbig(out));
+    EXPECT_EQ(files(), std::vector<std::string>{});
+    // Under the same limit, an image that fits is written.
+    EXPECT_EQ(write_error_with_file_size_limit(4096, [&] { write_image(out, 4, 4, noise(), Encoding::Srgb, pixels); }),
+              "no error");
+    EXPECT_EQ(files(), std::vector<std::string>{"out.exr"});
+    fs::remove(out);
+  }
+}
+
+// OpenEXR refusing an image (here one with no pixels, which no render has) is an
+// OutputWriteError too: one line, the file and the library's reason.
+TEST_F(FullDisk, ExrWriteTheLibraryRefusesNamesTheFileAndLeavesNothing) {
+  const std::string out = path("empty.exr");
+  try {
+    write_image(out, 0, 4, {}, Encoding::Srgb);
+    ADD_FAILURE() << "an image of width 0 was written";
+  } catch (const OutputWriteError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(out + ": cannot write (", 0), 0u) << message;
+    EXPECT_GT(message.size(), out.size() + std::string(": cannot write ()").size()) << message;  // a reason
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
   EXPECT_EQ(files(), std::vector<std::string>{});
 }
 

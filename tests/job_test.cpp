@@ -15,6 +15,7 @@
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
+#include "exr_support.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -105,6 +106,37 @@ void expect_bad_input(const JobOutcome& o, const std::string& must_contain) {
   EXPECT_EQ(o.exit_code, kExitBadInput);
   EXPECT_NE(o.message.find(must_contain), std::string::npos) << o.message;
   EXPECT_EQ(o.message.find('\n'), std::string::npos) << "one line: " << o.message;
+}
+
+// The same render as a PFM and as OpenEXR, half and float: the EXR holds the PFM's
+// values (half-rounded by default, exact with exr_float) at the same pixels.
+TEST_F(JobTest, ExrOutputHoldsTheRendersLinearValues) {
+  const std::string scene = write("s.json", kTinyScene);
+  ASSERT_EQ(run_job(small_job(scene, path("out.pfm"))).exit_code, 0);
+  const std::vector<float> pfm = test::read_pfm(path("out.pfm"), 16, 9);
+  ASSERT_EQ(pfm.size(), 16u * 9 * 3);
+  Job half_job = small_job(scene, path("half.exr"));
+  Job float_job = small_job(scene, path("float.exr"));
+  float_job.exr_float = true;
+  ASSERT_EQ(run_job(half_job).exit_code, 0);
+  ASSERT_EQ(run_job(float_job).exit_code, 0);
+  const test::ExrImage half_image = test::read_exr(path("half.exr")), float_image = test::read_exr(path("float.exr"));
+  EXPECT_EQ(half_image.types, std::vector<Imf::PixelType>(4, Imf::HALF));
+  EXPECT_EQ(float_image.types, std::vector<Imf::PixelType>(4, Imf::FLOAT));
+  ASSERT_EQ(half_image.rgba.size(), 16u * 9 * 4);
+  ASSERT_EQ(float_image.rgba.size(), 16u * 9 * 4);
+  size_t lit = 0;
+  for (size_t p = 0; p < 16 * 9; ++p) {
+    for (size_t c = 0; c < 3; ++c) {
+      EXPECT_EQ(half_image.rgba[p * 4 + c], test::half_rounded(pfm[p * 3 + c])) << "pixel " << p;
+      EXPECT_EQ(float_image.rgba[p * 4 + c], pfm[p * 3 + c]) << "pixel " << p;
+      lit += pfm[p * 3 + c] > 0.0f;
+    }
+    EXPECT_EQ(half_image.rgba[p * 4 + 3], 1.0f);
+    EXPECT_EQ(float_image.rgba[p * 4 + 3], 1.0f);
+  }
+  EXPECT_GT(lit, 0u);  // the render is not black
+  EXPECT_TRUE(only_expected_files({"s.json", "out.pfm", "half.exr", "float.exr"}));
 }
 
 TEST_F(JobTest, MissingSceneFileIsBadInputAndWritesNothing) {
@@ -273,6 +305,22 @@ TEST_F(JobTest, SceneFilesAndRenderSettingsShareTheRanges) {
   p.roulette_depth = 1 << 30;
   p.seed = 4294967295u;
   EXPECT_EQ(error_of([&] { validate_params(p); }), "");
+}
+
+TEST_F(JobTest, JobsFilesTakeExrFloatAsABoolean) {
+  std::string jobs = write("jobs.json", R"({"defaults": {"exr_float": true}, "jobs": [
+    {"scene": "s.json", "output": "a.exr"},
+    {"scene": "s.json", "output": "b.exr", "exr_float": false},
+    {"scene": "s.json", "output": "c.exr", "exr_float": 1}]})");
+  std::vector<PlannedJob> planned = read_jobs_file(jobs, Job{});
+  ASSERT_EQ(planned.size(), 3u);
+  EXPECT_EQ(planned[0].error, "");
+  EXPECT_TRUE(planned[0].job.exr_float);
+  EXPECT_EQ(planned[1].error, "");
+  EXPECT_FALSE(planned[1].job.exr_float);
+  EXPECT_EQ(planned[2].error, jobs + ": /jobs/2/exr_float: must be true or false (got number)");
+  EXPECT_FALSE(read_jobs_file(write("jobs.json", R"({"jobs": [{"scene": "s.json", "output": "a.exr"}]})"), Job{})[0]
+                   .job.exr_float);
 }
 
 TEST_F(JobTest, JobsFilesRejectRepeatedAndUnknownKeys) {

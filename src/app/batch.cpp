@@ -31,7 +31,8 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 // The keys of a job (and of "defaults"): the files, then every setting of the table.
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k = {"scene", "output", "stats", "checkpoint", "resume", "backend", "kernel", "encoding"};
+    std::vector<std::string> k = {"scene", "output", "stats", "checkpoint", "resume", "backend", "kernel", "encoding",
+                                  "exr_float"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -61,6 +62,8 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.kernel = kernel_names()[r.choice(value, at, kernel_names())];
     } else if (key == "encoding") {
       job.encoding = r.choice(value, at, encoding_choices()) == 0 ? Encoding::Srgb : Encoding::Gamma2;
+    } else if (key == "exr_float") {
+      job.exr_float = r.boolean(value, at);
     } else {
       for (const Setting& s : settings()) {
         if (key == s.key) set_setting(job, s.id, r.integer(value, at, s.lo, s.hi));

@@ -17,6 +17,7 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
       ->check(CLI::IsMember(kernel_names()));
   cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
       ->check(CLI::IsMember(encoding_choices()));
+  cmd.add_flag("--exr-float", job.exr_float, "OpenEXR output in 32-bit floats (default: half floats)");
   cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
 }
 
@@ -34,7 +35,9 @@ Job RenderCommand::parsed() const {
 CLI::App* add_render_command(CLI::App& app, RenderCommand& cmd) {
   CLI::App* render = app.add_subcommand("render", "render one scene");
   render->add_option("scene", cmd.job.scene, "scene file (JSON)")->required();
-  render->add_option("-o,--output", cmd.job.output, "image file: .png (8-bit) or .pfm (linear float)")->required();
+  render->add_option("-o,--output", cmd.job.output,
+                     "image file: .png (8-bit), .pfm (linear float) or .exr (linear half or float)")
+      ->required();
   render->add_option("--stats", cmd.job.stats, "write render statistics as JSON");
   render->add_option("--checkpoint", cmd.job.checkpoint,
                      "write the film's sums here every --checkpoint-every seconds and on SIGINT/SIGTERM; "
@@ -60,6 +63,7 @@ std::vector<std::string> render_arguments(const Job& job) {
   add("--backend", job.backend);
   add("--kernel", job.kernel);
   add("--encoding", encoding_choices()[job.encoding == Encoding::Srgb ? 0 : 1]);
+  if (job.exr_float) args.push_back("--exr-float");
   if (!job.progress) args.push_back("--quiet");
   if (job.profile) args.push_back("--profile");
   args.push_back("--");  // the scene, whatever its name

@@ -213,7 +213,7 @@ JobOutcome run_job(const Job& job) {
     // Both files are written in full before either takes its name: a disk that fills
     // up during the second leaves neither.
     StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
-                                   job.encoding);
+                                   job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
     StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
     image.commit();
     stats.commit();

@@ -29,6 +29,7 @@ struct Job {
   std::string checkpoint, resume;
   int64_t checkpoint_every = 300;
   Encoding encoding = Encoding::Srgb;
+  bool exr_float = false;  // an .exr output's pixels: 32-bit floats rather than half floats
   bool progress = true;
   bool profile = false;
 };

@@ -1,9 +1,17 @@
 #include "image/image_io.hpp"
 
+#include <IexBaseExc.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfOutputFile.h>
 #include <fcntl.h>
+#include <half.h>
 #include <stb/stb_image_write.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -19,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-enum class Format { Png, Pfm };
+enum class Format { Png, Pfm, Exr };
 
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
@@ -31,7 +39,8 @@ Format format_of(const std::string& path) {
   std::string ext = lower_extension(path);
   if (ext == ".png") return Format::Png;
   if (ext == ".pfm") return Format::Pfm;
-  throw OutputError(path + ": unknown output format '" + ext + "' (use .png or .pfm)");
+  if (ext == ".exr") return Format::Exr;
+  throw OutputError(path + ": unknown output format '" + ext + "' (use .png, .pfm or .exr)");
 }
 
 fs::path folder_of(const std::string& path) {
@@ -86,6 +95,11 @@ class FileWriter {
   void fail(int err) noexcept {
     if (error_ == 0) error_ = err;
   }
+  // Moves to byte `offset` of the file, for writers that go back to fill in a table.
+  void seek(uint64_t offset) noexcept {
+    if (error_ == 0 && ::lseek(fd_, static_cast<off_t>(offset), SEEK_SET) < 0) error_ = errno;
+  }
+  bool failed() const noexcept { return error_ != 0; }
 
   // Flushes to the disk and closes: errors that only show there (a full disk under
   // delayed allocation, a failed device, a network file system) are found here.
@@ -126,6 +140,75 @@ StagedFile stage_pfm(const std::string& path, int w, int h, const std::vector<fl
   f.write(header.data(), header.size());
   for (int y = h - 1; y >= 0; --y) {
     f.write(rgb.data() + static_cast<size_t>(y) * w * 3, sizeof(float) * w * 3);
+  }
+  return f.finish();
+}
+
+// OpenEXR's output stream over the file writer. A failed write is recorded rather than
+// thrown: OpenEXR writes the table of row offsets from its OutputFile's destructor,
+// which swallows exceptions, and finish() must still see that write's failure.
+class ExrStream : public Imf::OStream {
+ public:
+  ExrStream(FileWriter& f, const std::string& path) : Imf::OStream(path.c_str()), f_(f) {}
+  void write(const char c[], int n) override {
+    f_.write(c, static_cast<size_t>(n));
+    position_ += static_cast<uint64_t>(n);
+  }
+  uint64_t tellp() override { return position_; }
+  void seekp(uint64_t position) override {
+    f_.seek(position);
+    position_ = position;
+  }
+
+ private:
+  FileWriter& f_;
+  uint64_t position_ = 0;
+};
+
+// Channels R, G, B and A (= 1) of type T (float or half), ZIP-compressed, rows from the
+// top (the header's default line order). `rgb` holds width * height * 3 values of T.
+template <typename T>
+void write_exr_pixels(Imf::OStream& stream, int w, int h, const T* rgb, Imf::PixelType type) {
+  Imf::Header header(w, h);
+  Imf::FrameBuffer frame;
+  const char* const names[] = {"R", "G", "B"};
+  // An output file only reads its frame buffer.
+  char* const base = const_cast<char*>(reinterpret_cast<const char*>(rgb));
+  for (size_t c = 0; c < 3; ++c) {
+    header.channels().insert(names[c], Imf::Channel(type));
+    frame.insert(names[c],
+                 Imf::Slice(type, base + c * sizeof(T), sizeof(T) * 3, sizeof(T) * 3 * static_cast<size_t>(w)));
+  }
+  // One row of ones serves every row (a row stride of 0).
+  std::vector<T> alpha(static_cast<size_t>(std::max(w, 0)), T(1.0f));
+  header.channels().insert("A", Imf::Channel(type));
+  frame.insert("A", Imf::Slice(type, reinterpret_cast<char*>(alpha.data()), sizeof(T), 0));
+  Imf::OutputFile file(stream, header);  // its destructor writes the row offsets
+  file.setFrameBuffer(frame);
+  file.writePixels(h);
+}
+
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return text;
+}
+
+StagedFile stage_exr(const std::string& path, int w, int h, const std::vector<float>& rgb, ExrPixels pixels) {
+  FileWriter f(path);
+  try {
+    ExrStream stream(f, path);
+    if (pixels == ExrPixels::Float) {
+      write_exr_pixels(stream, w, h, rgb.data(), Imf::FLOAT);  // the render's floats, in place
+    } else {
+      const std::vector<half> rgb_half(rgb.begin(), rgb.end());  // rounded to nearest
+      write_exr_pixels(stream, w, h, rgb_half.data(), Imf::HALF);
+    }
+  } catch (const Iex::BaseExc& e) {
+    // A failed write of the file's bytes is reported by finish(), with the system's
+    // reason; any other refusal of the library's is reported with the library's.
+    if (!f.failed()) throw OutputWriteError(path + ": cannot write (" + one_line(e.what()) + ")");
   }
   return f.finish();
 }
@@ -177,9 +260,13 @@ void StagedFile::commit() {
 }
 
 StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
-                       Encoding encoding) {
-  return format_of(path) == Format::Png ? stage_png(path, width, height, rgb, encoding)
-                                        : stage_pfm(path, width, height, rgb);
+                       Encoding encoding, ExrPixels exr) {
+  switch (format_of(path)) {
+    case Format::Png: return stage_png(path, width, height, rgb, encoding);
+    case Format::Pfm: return stage_pfm(path, width, height, rgb);
+    case Format::Exr: return stage_exr(path, width, height, rgb, exr);
+  }
+  throw OutputError(path + ": unknown output format");  // not reached: format_of names every format
 }
 
 StagedFile stage_file(const std::string& path, const std::string& text) {
@@ -188,8 +275,9 @@ StagedFile stage_file(const std::string& path, const std::string& text) {
   return f.finish();
 }
 
-void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding) {
-  stage_image(path, width, height, rgb, encoding).commit();
+void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding,
+                 ExrPixels exr) {
+  stage_image(path, width, height, rgb, encoding, exr).commit();
 }
 
 void write_file(const std::string& path, const std::string& text) { stage_file(path, text).commit(); }

@@ -1,6 +1,7 @@
-// Writing rendered images: PNG (8-bit) or PFM (linear float), chosen by extension,
-// always through a temporary file renamed into place, so a failed or interrupted
-// write never leaves a partial image under the requested name.
+// Writing rendered images: PNG (8-bit), PFM (linear float) or OpenEXR (linear RGBA,
+// half or float), chosen by extension, always through a temporary file renamed into
+// place, so a failed or interrupted write never leaves a partial image under the
+// requested name.
 #pragma once
 
 #include <stdexcept>
@@ -21,6 +22,8 @@ struct OutputWriteError : OutputError {
 };
 
 enum class Encoding { Srgb, Gamma2 };
+// The pixel type of an OpenEXR image's channels.
+enum class ExrPixels { Half, Float };
 
 // Throws OutputError naming the path when it cannot be written (unknown extension,
 // missing or unwritable folder). Run before rendering, so a bad path costs nothing.
@@ -52,14 +55,16 @@ class StagedFile {
 };
 
 // rgb: linear radiance, width * height * 3, row 0 = top. The encoding applies to PNG;
-// PFM keeps linear values. Throws OutputWriteError when the write fails.
+// PFM and OpenEXR keep linear values, and `exr` is the pixel type of an OpenEXR image
+// (its alpha is 1). Throws OutputWriteError when the write fails.
 StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
-                       Encoding encoding);
+                       Encoding encoding, ExrPixels exr = ExrPixels::Half);
 // Any bytes (a stats file's text, a checkpoint).
 StagedFile stage_file(const std::string& path, const std::string& bytes);
 
 // Stage and commit at once.
-void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding);
+void write_image(const std::string& path, int width, int height, const std::vector<float>& rgb, Encoding encoding,
+                 ExrPixels exr = ExrPixels::Half);
 void write_file(const std::string& path, const std::string& bytes);
 
 }  // namespace wt
