@@ -84,9 +84,10 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   int stack[kStack];
   float stack_t[kStack];
   int top = 0;
-  int node = 0;
+  // The node in hand: its record came with its sibling's when their parent was
+  // visited, so a step down costs one fetch (the two children), not two.
+  BvhNode n = g.node(0);
   for (;;) {
-    BvhNode n = g.node(node);
     if (n.count > 0 && instance < 0) {
       instance = n.left_or_first;
       const Instance& in = g.instance(instance);
@@ -101,29 +102,24 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
         stack[top] = kReturnToWorld;
         stack_t[top++] = 0.0f;
       }
-      node = in.root;
+      n = g.node(in.root);
       continue;
     }
     if (n.count > 0) {
       intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
     } else {
-      int a = n.left_or_first, b = n.left_or_first + 1;
-      float ta = box_entry<kTriangles>(g.node(a), ray.origin, inv, hit.t);
-      float tb = box_entry<kTriangles>(g.node(b), ray.origin, inv, hit.t);
-      if (ta > tb) {
-        float tt = ta;
-        ta = tb;
-        tb = tt;
-        int ti = a;
-        a = b;
-        b = ti;
-      }
-      if (ta <= hit.t) {
-        if (tb <= hit.t && top < kStack) {
-          stack[top] = b;
-          stack_t[top++] = tb;
+      const int a = n.left_or_first;
+      const BvhNode na = g.node(a), nb = g.node(a + 1);
+      const float ta = box_entry<kTriangles>(na, ray.origin, inv, hit.t);
+      const float tb = box_entry<kTriangles>(nb, ray.origin, inv, hit.t);
+      const bool a_first = ta <= tb;
+      const float t_near = a_first ? ta : tb, t_far = a_first ? tb : ta;
+      if (t_near <= hit.t) {
+        if (t_far <= hit.t && top < kStack) {
+          stack[top] = a_first ? a + 1 : a;
+          stack_t[top++] = t_far;
         }
-        node = a;
+        n = a_first ? na : nb;
         continue;
       }
     }
@@ -140,7 +136,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
         continue;
       }
       if (stack_t[top] <= hit.t) {
-        node = stack[top];
+        n = g.node(stack[top]);
         found = true;
         break;
       }
