@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "cuda/buffer.hpp"
@@ -20,13 +21,45 @@
 
 namespace wt::cuda {
 
+// An item may bound its kernel's registers with `static constexpr int
+// kMinBlocksPerSm`: the kernel is then compiled for blocks of at most kBoundedBlock
+// threads of which that many fit on an SM at once, so the compiler keeps each
+// thread within 65536 / (kBoundedBlock * kMinBlocksPerSm) registers. Worth it where
+// a kernel waits on memory more than it computes (intersect; bench/RESULTS.md).
+constexpr int kBoundedBlock = 256;
+template <class Item, class = void>
+struct MinBlocksPerSm {
+  static constexpr int value = 0;  // unbounded
+};
+template <class Item>
+struct MinBlocksPerSm<Item, std::void_t<decltype(Item::kMinBlocksPerSm)>> {
+  static constexpr int value = Item::kMinBlocksPerSm;
+};
+
 template <class Item>
 __global__ void for_each_kernel(Item item, uint32_t n) {
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i < n) item(i);
 }
 
-// The block size for for_each_kernel<Item>, asked of the occupancy API once per
+template <class Item>
+__global__ void __launch_bounds__(kBoundedBlock, MinBlocksPerSm<Item>::value)
+    for_each_bounded_kernel(Item item, uint32_t n) {
+  const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i < n) item(i);
+}
+
+// The kernel that runs Item over a range.
+template <class Item>
+constexpr auto stage_kernel() {
+  if constexpr (MinBlocksPerSm<Item>::value > 0) {
+    return for_each_bounded_kernel<Item>;
+  } else {
+    return for_each_kernel<Item>;
+  }
+}
+
+// The block size for stage_kernel<Item>(), asked of the occupancy API once per
 // item type: the smallest block that reaches the highest occupancy the kernel can
 // have, in steps of four warps, one for each of an SM's four schedulers. Smaller
 // blocks at the same occupancy leave less of the device idle while the last blocks
@@ -37,7 +70,7 @@ template <class Item>
 int block_size_for(const Stage& s) {
   static const int block = [&] {
     cudaFuncAttributes attributes{};
-    WT_CUDA(cudaFuncGetAttributes(&attributes, for_each_kernel<Item>), s.name);
+    WT_CUDA(cudaFuncGetAttributes(&attributes, stage_kernel<Item>()), s.name);
     int device = 0, warp = 0;
     WT_CUDA(cudaGetDevice(&device), s.name);
     WT_CUDA(cudaDeviceGetAttribute(&warp, cudaDevAttrWarpSize, device), s.name);
@@ -45,7 +78,7 @@ int block_size_for(const Stage& s) {
     int best = step, best_threads = 0;
     for (int size = step; size <= attributes.maxThreadsPerBlock; size += step) {
       int blocks = 0;
-      WT_CUDA(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, for_each_kernel<Item>, size, 0), s.name);
+      WT_CUDA(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, stage_kernel<Item>(), size, 0), s.name);
       if (blocks * size > best_threads) {
         best_threads = blocks * size;
         best = size;
@@ -85,7 +118,7 @@ class Executor {
     if (n == 0) return;
     const int block = block_size_for<Item>(s);
     timed(s, [&] {
-      for_each_kernel<<<(n + block - 1) / block, block, 0, stream_>>>(item, n);
+      stage_kernel<Item>()<<<(n + block - 1) / block, block, 0, stream_>>>(item, n);
       check(static_cast<int>(cudaGetLastError()), "kernel launch", s.name);
     });
   }
