@@ -38,10 +38,11 @@ WT_HD WT_INLINE Ray queued_ray(const PathQueue& q, uint32_t i) {
 // over the whole capacity without the host knowing the count, drops them.
 template <uint32_t Kinds>
 struct IntersectItem {
-  // On the GPU, at most 64 registers a thread (cuda/executor.cuh): the traversal
-  // waits on memory, and the occupancy this buys traces the mesh scenes 5-6%
-  // faster than the 69 registers it would take unbounded.
-  static constexpr int kMinBlocksPerSm = 4;
+  // On the GPU, at most 64 registers a thread for scenes with triangles
+  // (cuda/executor.cuh): their traversal waits on memory, and the occupancy this
+  // buys traces the mesh scenes 5-6% faster than the 69 registers it takes
+  // unbounded. Spheres alone need 44 and keep the unbounded kernel.
+  static constexpr int kMinBlocksPerSm = Kinds == kSpheresOnly ? 0 : 4;
   SceneView scene;
   RenderParams rp;
   PathQueue queue;
