@@ -231,8 +231,8 @@ TEST(SceneParser, UniformSkyUsesItsRadianceEverywhere) {
   json doc = with(base_scene(), "/sky", {{"type", "uniform"}, {"radiance", {0.2, 3, 0.4}}});
   Scene s = parse_scene(doc.dump(), kSource);
   EXPECT_EQ(s.sky.kind, SkyKind::Uniform);
-  EXPECT_EQ(s.sky.radiance(vec3(0, 1, 0)), vec3(0.2f, 3.0f, 0.4f));
-  EXPECT_EQ(s.sky.radiance(vec3(0, -1, 0)), vec3(0.2f, 3.0f, 0.4f));
+  EXPECT_EQ(s.sky.radiance(vec3(0, 1, 0), nullptr), vec3(0.2f, 3.0f, 0.4f));
+  EXPECT_EQ(s.sky.radiance(vec3(0, -1, 0), nullptr), vec3(0.2f, 3.0f, 0.4f));
 }
 
 TEST(SceneParser, MissingFileIsReported) {
@@ -398,7 +398,7 @@ TEST(SceneParser, UnknownTypesAreRejected) {
                 "coated, emissive)");
   expect_error(with(doc, "/textures/1/type", "wood"), "/textures/1/type",
                "unknown texture type 'wood' (expected checker, noise, image)");
-  expect_error(with(doc, "/sky/type", "hdri"), "/sky/type", "unknown sky type 'hdri' (expected gradient, uniform)");
+  expect_error(with(doc, "/sky/type", "hdri"), "/sky/type", "unknown sky type 'hdri' (expected gradient, uniform, environment)");
 }
 
 TEST(SceneParser, RenderValuesOutsideTheirRangesAreRejected) {

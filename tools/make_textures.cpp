@@ -2,7 +2,9 @@
 //
 // Writes the five image textures that scenes/seed57.json uses: four 256 x 256
 // "light probe" images in mirror-ball format and one 756 x 378
-// latitude-longitude planet map. They are made procedurally so that the project
+// latitude-longitude planet map; and sky_sun.hdr, a 512 x 256 latitude-longitude
+// environment in linear radiance (a clear sky with a sun disc over dark ground)
+// that lights scenes/sky-sun.json. They are made procedurally so that the project
 // ships its own textures instead of depending on photographs it cannot
 // redistribute. The sizes match the reference scene's textures so that texture
 // memory traffic is comparable.
@@ -339,6 +341,50 @@ Image8 make_planet(int width, int height) {
   return img;
 }
 
+// The clear sky of sky_sun.hdr, in linear radiance: blue overhead, paler and
+// brighter toward the horizon, a sun disc 1.5 degrees in radius at 30 degrees
+// elevation with a glow around it, and dark ground below the horizon.
+const vec3 kSunDirection = glm::normalize(vec3(0.45f, 0.48f, -0.75f));
+constexpr float kSunRadius = 1.5f * kPi / 180.0f;
+vec3 clear_sky(const vec3& d) {
+  if (d.y < 0.0f) return vec3(0.12f, 0.1f, 0.08f);  // the ground
+  const float toward_horizon = std::pow(1.0f - d.y, 4.0f);
+  vec3 sky = mix(vec3(0.22f, 0.42f, 1.0f), vec3(1.1f, 1.2f, 1.3f), toward_horizon);
+  const float angle = std::acos(std::min(1.0f, glm::dot(d, kSunDirection)));
+  sky += vec3(4.0f, 3.4f, 2.6f) * std::exp(-angle / 0.08f);  // the glow
+  if (angle < kSunRadius) sky += vec3(2000.0f, 1850.0f, 1600.0f);
+  return sky;
+}
+
+// The sky on the renderer's latitude-longitude grid (u = atan2(x, -z) / 2 pi,
+// v = acos(y) / pi; docs/scene-format.md), 4 x 4 samples a texel for the sun's rim.
+std::vector<float> make_sky(int width, int height) {
+  constexpr int kSub = 4;
+  std::vector<float> rgb(static_cast<size_t>(width) * height * 3);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      vec3 sum(0.0f);
+      for (int sy = 0; sy < kSub; ++sy)
+        for (int sx = 0; sx < kSub; ++sx) {
+          const float phi = 2.0f * kPi * (x + (sx + 0.5f) / kSub) / width;
+          const float theta = kPi * (y + (sy + 0.5f) / kSub) / height;
+          sum += clear_sky(vec3(std::sin(phi) * std::sin(theta), std::cos(theta), -std::cos(phi) * std::sin(theta)));
+        }
+      const vec3 c = sum / float(kSub * kSub);
+      for (int k = 0; k < 3; ++k) rgb[3 * (static_cast<size_t>(y) * width + x) + k] = c[k];
+    }
+  return rgb;
+}
+
+bool write_hdr(const std::filesystem::path& path, int width, int height, const std::vector<float>& rgb) {
+  if (!stbi_write_hdr(path.string().c_str(), width, height, 3, rgb.data())) {
+    std::fprintf(stderr, "wavetrace-textures: cannot write %s\n", path.string().c_str());
+    return false;
+  }
+  std::printf("%s (%d x %d)\n", path.string().c_str(), width, height);
+  return true;
+}
+
 bool write_png(const std::filesystem::path& path, const Image8& img) {
   if (!stbi_write_png(path.string().c_str(), img.width, img.height, 3, img.rgb.data(), img.width * 3)) {
     std::fprintf(stderr, "wavetrace-textures: cannot write %s\n", path.string().c_str());
@@ -377,5 +423,6 @@ int main(int argc, char** argv) {
   bool ok = true;
   for (const auto& p : probes) ok = write_png(out / p.file, make_probe(p.env, kProbe)) && ok;
   ok = write_png(out / "planet.png", make_planet(756, 378)) && ok;
+  ok = write_hdr(out / "sky_sun.hdr", 512, 256, make_sky(512, 256)) && ok;
   return ok ? 0 : 1;
 }

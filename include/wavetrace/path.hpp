@@ -59,7 +59,7 @@ WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint
     Hit hit = intersect_scene<Kinds>(scene, ray);
     ++rays;
     if (hit.missed()) {
-      radiance += throughput * scene.sky.radiance(ray.dir);
+      radiance += throughput * scene.sky.radiance(ray.dir, scene.image_array());
       break;
     }
     if (!shade_hit<Kinds>(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance)) break;

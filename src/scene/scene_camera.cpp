@@ -1,4 +1,6 @@
 // Scene files: the camera, the sky and the render settings (docs/scene-format.md).
+#include <cmath>
+
 #include "render/settings.hpp"
 #include "scene/scene_reader.hpp"
 
@@ -32,8 +34,41 @@ void SceneReader::read_camera(const json& j, const JsonPath& path) {
 }
 
 void SceneReader::read_sky(const json& j, const JsonPath& path) {
-  size_t type = type_of(j, path, "sky", {"gradient", "uniform"});
-  if (type == 0) {
+  size_t type = type_of(j, path, "sky", {"gradient", "uniform", "environment"});
+  if (type == 2) {
+    check_keys(j, path, {"type", "file", "mapping", "rotation", "intensity", "colorspace"}, "environment");
+    Sky& sky = scene_.sky;
+    sky.kind = SkyKind::Environment;
+    sky.mapping = EnvironmentMapping::LatLong;
+    if (j.contains("mapping")) {
+      const std::string m = string(j["mapping"], path / "mapping");
+      if (m == "latlong") {
+        sky.mapping = EnvironmentMapping::LatLong;
+      } else if (m == "angular") {
+        sky.mapping = EnvironmentMapping::Angular;
+      } else if (m == "mirror_ball") {
+        sky.mapping = EnvironmentMapping::MirrorBall;
+      } else {
+        fail_at(path / "mapping", "unknown mapping '" + m + "' (expected latlong, angular, mirror_ball)");
+      }
+    }
+    const float degrees = j.contains("rotation") ? number(j["rotation"], path / "rotation") : 0.0f;
+    const double radians = static_cast<double>(degrees) * 3.14159265358979323846 / 180.0;
+    sky.turn_cos = static_cast<float>(std::cos(radians));
+    sky.turn_sin = static_cast<float>(std::sin(radians));
+    sky.intensity = j.contains("intensity") ? non_negative(j["intensity"], path / "intensity") : 1.0f;
+    // 8-bit images are sRGB-encoded unless said otherwise, as image textures are;
+    // Radiance .hdr and OpenEXR images hold linear values.
+    bool srgb = true;
+    if (j.contains("colorspace")) {
+      const std::string cs = string(j["colorspace"], path / "colorspace");
+      if (cs != "srgb" && cs != "linear") {
+        fail_at(path / "colorspace", "unknown colorspace '" + cs + "' (expected srgb, linear)");
+      }
+      srgb = cs == "srgb";
+    }
+    sky.image = image(string(required(j, path, "file"), path / "file"), srgb, path / "file");
+  } else if (type == 0) {
     check_keys(j, path, {"type", "horizon", "zenith"}, "gradient");
     scene_.sky.kind = SkyKind::Gradient;
     if (j.contains("horizon")) scene_.sky.horizon = radiance(j["horizon"], path / "horizon");

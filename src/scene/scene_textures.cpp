@@ -1,6 +1,12 @@
-// Scene files: textures, and the images that image textures read.
+// Scene files: textures, and the images that image textures and the environment read.
+#include <ImathBox.h>
+#include <ImfArray.h>
+#include <ImfRgbaFile.h>
 #include <stb/stb_image.h>
 
+#include <cctype>
+#include <cmath>
+#include <exception>
 #include <utility>
 
 #include "scene/scene_reader.hpp"
@@ -58,11 +64,104 @@ int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const st
   return index;
 }
 
+namespace {
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
+bool read_hdr(const std::string& path, Image& im, std::string& why) {
+  int w = 0, h = 0, channels = 0;
+  float* data = stbi_loadf(path.c_str(), &w, &h, &channels, 0);
+  if (!data) {
+    why = stbi_failure_reason();
+    return false;
+  }
+  im.width = w;
+  im.height = h;
+  im.texels.resize(static_cast<size_t>(w) * h * 4);
+  for (size_t p = 0; p < static_cast<size_t>(w) * h; ++p) {
+    const float* texel = data + p * channels;
+    for (int c = 0; c < 3; ++c) im.texels[4 * p + c] = texel[channels >= 3 ? c : 0];
+    im.texels[4 * p + 3] = 1.0f;
+  }
+  stbi_image_free(data);
+  return true;
+}
+
+// An OpenEXR file's RGBA through OpenEXR (missing channels read as 0, alpha as 1).
+bool read_exr(const std::string& path, Image& im, std::string& why) {
+  try {
+    Imf::RgbaInputFile file(path.c_str());
+    const Imath::Box2i window = file.dataWindow();
+    const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
+    if (w <= 0 || h <= 0) {
+      why = "the image is empty";
+      return false;
+    }
+    Imf::Array2D<Imf::Rgba> pixels(h, w);
+    file.setFrameBuffer(&pixels[0][0] - window.min.x - static_cast<ptrdiff_t>(window.min.y) * w, 1, w);
+    file.readPixels(window.min.y, window.max.y);
+    im.width = w;
+    im.height = h;
+    im.texels.resize(static_cast<size_t>(w) * h * 4);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const Imf::Rgba& p = pixels[y][x];
+        float* t = &im.texels[4 * (static_cast<size_t>(y) * w + x)];
+        t[0] = p.r;
+        t[1] = p.g;
+        t[2] = p.b;
+        t[3] = p.a;
+      }
+    }
+    return true;
+  } catch (const std::exception& e) {
+    why = e.what();
+    for (char& c : why) c = c == '\n' ? ' ' : c;
+    return false;
+  }
+}
+
+// High-dynamic-range images are radiance: every value finite and not negative.
+bool check_radiance(const Image& im, std::string& why) {
+  for (size_t i = 0; i < im.texels.size(); ++i) {
+    const float v = im.texels[i];
+    if (!std::isfinite(v) || v < 0.0f) {
+      const size_t p = i / 4;
+      why = "texel (" + std::to_string(p % im.width) + ", " + std::to_string(p / im.width) + ") holds " +
+            (std::isfinite(v) ? std::to_string(v) : std::string(std::isnan(v) ? "NaN" : "an infinity")) +
+            "; an image of radiance needs finite values of at least 0";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::string& why) {
   auto known = images_.find({resolved, srgb});
   if (known != images_.end()) return known->second;
 
   const auto start = Clock::now();
+  // Radiance .hdr and OpenEXR files hold linear values, whatever the colorspace says.
+  const std::string ext = lower_extension(resolved);
+  if (ext == ".hdr" || ext == ".exr") {
+    Image im;
+    im.path = resolved;
+    if (!(ext == ".hdr" ? read_hdr(resolved, im, why) : read_exr(resolved, im, why)) || !check_radiance(im, why)) {
+      return -1;
+    }
+    texture_seconds_ += seconds_since(start);
+    const int32_t index = static_cast<int32_t>(scene_.images.size());
+    scene_.images.push_back(std::move(im));
+    images_.emplace(std::make_pair(resolved, srgb), index);
+    return index;
+  }
   // Read in the file's own channels and widened to RGBA here: stb 2.27 (Debian
   // bookworm) reads past its buffer when it converts a 16-bit PNM to 4 channels.
   int w = 0, h = 0, channels = 0;

@@ -22,7 +22,7 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
   if (h.missed()) {
     const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);
-    accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir));
+    accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir, scene.image_array()));
     return pack_entry(kSortKeyMiss, i);
   }
   return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);
