@@ -41,6 +41,8 @@ class MeshScene : public testing::Test {
   }
 
   // load_scene must fail with one line that starts with `file` and holds each of `parts`.
+  // The message starts with `file: ` (for a mesh file's error: the scene file, the
+  // field that names the mesh file, then the mesh file).
   void expect_error(const std::string& scene, const std::string& file, std::initializer_list<std::string> parts) {
     try {
       load_scene(scene);
@@ -71,25 +73,25 @@ TEST_F(MeshScene, GoodSceneLoads) {
 
 TEST_F(MeshScene, MissingMeshFileNamesTheFile) {
   const std::string scene = write_scene(R"([{"name": "a", "file": "no-such.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, path("no-such.obj"), {"cannot open mesh file"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("no-such.obj"), {"cannot open mesh file"});
 }
 
 TEST_F(MeshScene, UnreadableMeshFileNamesTheFile) {
   fs::create_directories(path("folder.obj"));  // opens, but cannot be read
   const std::string scene = write_scene(R"([{"name": "a", "file": "folder.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, path("folder.obj"), {"mesh file"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("folder.obj"), {"mesh file"});
 }
 
 TEST_F(MeshScene, MalformedObjNamesTheFile) {
   std::ofstream(path("bad.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";  // a corner that does not exist
   const std::string scene = write_scene(R"([{"name": "a", "file": "bad.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, path("bad.obj"), {"malformed OBJ", "out of bounds", "line 4"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("bad.obj"), {"malformed OBJ", "out of bounds", "line 4"});
 }
 
 TEST_F(MeshScene, ObjWithAMissingMtlNamesTheFile) {
   std::ofstream(path("mtl.obj")) << "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n";
   const std::string scene = write_scene(R"([{"name": "a", "file": "mtl.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, path("mtl.obj"), {"malformed OBJ"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("mtl.obj"), {"malformed OBJ"});
 }
 
 TEST_F(MeshScene, UnknownMeshInAnInstance) {

@@ -46,10 +46,26 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   const auto start = Clock::now();
   std::vector<std::future<TriangleMesh>> loading;
   for (const Spec& s : specs) loading.push_back(std::async(std::launch::async, load_mesh, s.file));
+  // A mesh file's error names the scene file and the field that names the mesh
+  // file, then the mesh file and what is wrong in it.
   std::vector<TriangleMesh> meshes;
-  for (auto& f : loading) meshes.push_back(f.get());
+  std::string first_error;
+  for (size_t i = 0; i < loading.size(); ++i) {
+    try {
+      meshes.push_back(loading[i].get());
+    } catch (const SceneError& e) {
+      if (first_error.empty()) first_error = source() + ": " + (path / i / "file").str() + ": " + e.what();
+    }
+  }
+  if (!first_error.empty()) throw SceneError(first_error);
   mesh_seconds_ += seconds_since(start);
-  for (size_t i = 0; i < meshes.size(); ++i) add_mesh(meshes[i], specs[i].name, specs[i].material);
+  for (size_t i = 0; i < meshes.size(); ++i) {
+    try {
+      add_mesh(meshes[i], specs[i].name, specs[i].material);
+    } catch (const SceneError& e) {  // a texture its materials name, its size
+      throw SceneError(source() + ": " + (path / i / "file").str() + ": " + e.what());
+    }
+  }
 }
 
 void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override) {
