@@ -56,4 +56,30 @@ inline double mean_abs_diff(const std::vector<float>& a, const std::vector<float
   return s / a.size();
 }
 
+// Every CUDA kernel's render against the CPU megakernel's, same seed, by render(
+// backend, kernel, seed). The two trace the same paths but round differently (FMA
+// contraction, device sqrt and division), so a path can take another branch (a
+// roulette draw, a hit at an edge) and from there on is an independent sample. The
+// bounds are set against what fully independent renders differ by: the CPU's own
+// render with the next seed, measured here. The CUDA image must be within a tenth
+// of that difference on average per value (at most about a tenth of the paths may
+// have diverged), and its mean within 3% of the CPU's (a tenth diverged moves the
+// mean by about sqrt(0.2) of its own spread, a few percent at the sizes the tests
+// use; the bound is there to catch energy lost or gained on one backend).
+template <class Render>
+void expect_cuda_agrees_with_cpu(Render render, uint32_t seed) {
+  const RenderResult cpu = render(Backend::Cpu, Kernel::Megakernel, seed);
+  const RenderResult other_seed = render(Backend::Cpu, Kernel::Megakernel, seed + 1);
+  const double independent = mean_abs_diff(cpu.rgb, other_seed.rgb);
+  ASSERT_GT(independent, 1e-3) << "two seeds should give visibly different noise";
+  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+    const RenderResult gpu = render(Backend::Cuda, k, seed);
+    ASSERT_EQ(gpu.rgb.size(), cpu.rgb.size()) << kernel_name(k);
+    const double mad = mean_abs_diff(cpu.rgb, gpu.rgb);
+    EXPECT_LT(mad, 0.1 * independent) << kernel_name(k) << " (other seed: " << independent << ")";
+    EXPECT_NEAR(mean(gpu.rgb), mean(cpu.rgb), 0.03 * mean(cpu.rgb)) << kernel_name(k);
+    EXPECT_NEAR(static_cast<double>(gpu.rays), static_cast<double>(cpu.rays), 2e-3 * cpu.rays) << kernel_name(k);
+  }
+}
+
 }  // namespace wt::test
