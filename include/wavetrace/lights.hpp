@@ -1,0 +1,106 @@
+// Sampling emitters from a shading point, and weighing two sampling strategies
+// against each other: the parts of next-event estimation that know nothing of the
+// scene's arrays. Densities are per unit solid angle at the shading point.
+//
+// Not yet called by the shading code: light sampling is being added in steps
+// (issue 8), and these are tested on their own first (tests/light_sampling_test.cpp).
+#pragma once
+
+#include "wavetrace/config.hpp"
+
+namespace wt {
+
+struct LightSample {
+  vec3 dir;    // unit, from the shading point toward the light
+  float dist;  // along dir to the light's surface
+  float pdf;   // per solid angle; 0: no sample (the point is inside the light, or sees it edge-on)
+};
+
+// Two unit vectors completing the unit vector n to a right-handed orthonormal basis
+// (t, b, n), without a branch on n's direction but for its sign (Duff et al. 2017).
+WT_HD WT_INLINE void orthonormal_basis(const vec3& n, vec3& t, vec3& b) {
+  const float sign = copysignf(1.0f, n.z);
+  const float a = -1.0f / (sign + n.z);
+  const float c = n.x * n.y * a;
+  t = vec3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = vec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+// 1 - cos(theta_max) of the cone a sphere of radius r subtends at distance d > r,
+// written so that it keeps its precision for small spheres far away (where the
+// cosine is within rounding of 1): sin^2 / (1 + cos).
+WT_HD WT_INLINE float cone_one_minus_cos(float r, float d) {
+  const float sin2 = (r / d) * (r / d);
+  return sin2 / (1.0f + sqrtf(fmaxf(0.0f, 1.0f - sin2)));
+}
+
+// The density of sample_sphere_light for any direction that meets the sphere.
+WT_HD WT_INLINE float sphere_light_pdf(const vec3& center, float radius, const vec3& p) {
+  const vec3 to = center - p;
+  const float d = sqrtf(glm::dot(to, to));
+  if (!(d > radius)) return 0.0f;
+  return 1.0f / (2.0f * kPi * cone_one_minus_cos(radius, d));
+}
+
+// A direction uniform in the cone of directions from p that meet the sphere, and
+// the distance to its near side. Nothing from inside the sphere or on it.
+WT_HD WT_INLINE LightSample sample_sphere_light(const vec3& center, float radius, const vec3& p, float u1, float u2) {
+  LightSample s{vec3(0.0f), 0.0f, 0.0f};
+  const vec3 to = center - p;
+  const float d = sqrtf(glm::dot(to, to));
+  if (!(d > radius)) return s;
+  const vec3 w = to * (1.0f / d);
+  const float omc = cone_one_minus_cos(radius, d);
+  const float one_minus_cos = u1 * omc;  // 1 - cos(theta), uniform in [0, 1 - cos(theta_max))
+  const float cos_theta = 1.0f - one_minus_cos;
+  const float sin_theta = sqrtf(fmaxf(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+  const float phi = 2.0f * kPi * u2;
+  vec3 t, b;
+  orthonormal_basis(w, t, b);
+  s.dir = glm::normalize(sin_theta * cosf(phi) * t + sin_theta * sinf(phi) * b + cos_theta * w);
+  // Along dir, the sphere's near side: d cos - sqrt(r^2 - d^2 sin^2), with
+  // r^2 - d^2 sin^2 = (r - d sin)(r + d sin) against cancellation.
+  const float ds = d * sin_theta;
+  s.dist = d * cos_theta - sqrtf(fmaxf(0.0f, (radius - ds) * (radius + ds)));
+  s.pdf = 1.0f / (2.0f * kPi * omc);
+  return s;
+}
+
+// The density of sample_triangle_light at the direction `dir` (unit) that meets the
+// triangle (a, b, c) at distance `dist` from p: uniform by area, per solid angle.
+// Both faces emit.
+WT_HD WT_INLINE float triangle_light_pdf(const vec3& a, const vec3& b, const vec3& c, const vec3& dir, float dist) {
+  const vec3 n = glm::cross(b - a, c - a);
+  const float twice_area = sqrtf(glm::dot(n, n));
+  const float cos_light = fabsf(glm::dot(n, dir)) / twice_area;
+  const float projected = 0.5f * twice_area * cos_light;  // the area seen along dir
+  if (!(projected > 0.0f)) return 0.0f;
+  return dist * dist / projected;
+}
+
+// A point uniform by area on the triangle (a, b, c), as a direction from p, its
+// distance and the density per solid angle.
+WT_HD WT_INLINE LightSample sample_triangle_light(const vec3& a, const vec3& b, const vec3& c, const vec3& p,
+                                                 float u1, float u2) {
+  LightSample s{vec3(0.0f), 0.0f, 0.0f};
+  const float su = sqrtf(u1);
+  const float b0 = 1.0f - su, b1 = u2 * su;
+  const vec3 q = b0 * a + b1 * b + (1.0f - b0 - b1) * c;
+  const vec3 v = q - p;
+  const float dist = sqrtf(glm::dot(v, v));
+  if (!(dist > 0.0f)) return s;
+  s.dir = v * (1.0f / dist);
+  s.dist = dist;
+  s.pdf = triangle_light_pdf(a, b, c, s.dir, dist);
+  return s;
+}
+
+// The power heuristic (exponent 2): the weight of a sample drawn by the strategy of
+// density f where another strategy would have drawn it with density g. The two
+// weights of a direction sum to 1.
+WT_HD WT_INLINE float power_heuristic(float f, float g) {
+  const float f2 = f * f, g2 = g * g;
+  return f2 + g2 > 0.0f ? f2 / (f2 + g2) : 0.0f;
+}
+
+}  // namespace wt
