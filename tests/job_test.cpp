@@ -379,7 +379,7 @@ TEST_F(JobTest, BenchSpecMistakesNameTheirPath) {
   const std::string spec = path("spec.json");
   EXPECT_EQ(error_with("\"roulette_depth\": 3", "\"roulete_depth\": 3"),
             spec + ": /groups/0/configs/1/roulete_depth: unknown key (expected width, height, spp, depth, "
-                   "roulette_depth, seed)");
+                   "roulette_depth, seed, nee)");
   EXPECT_EQ(error_with("\"wavefront\"]", "\"wavefrnt\"]"),
             spec + ": /groups/0/kernels/1: unknown value 'wavefrnt' (expected megakernel, megakernel-constant, "
                    "wavefront, wavefront-unsorted)");

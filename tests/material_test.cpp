@@ -322,13 +322,24 @@ struct OneSphereScene {
 
 RenderParams params(int roulette_depth) { return RenderParams{64, 64, 1, 8, roulette_depth, 77}; }
 
+// shade_hit after a camera ray (no BSDF density to weigh emission against); the
+// scenes here have no emitter table, so no light is sampled.
+bool shade(const SceneView& view, const RenderParams& rp, const Hit& hit, uint32_t pixel, uint32_t sample,
+           uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance) {
+  float pdf = 0.0f;
+  ShadowRay shadow;
+  const bool alive = shade_hit(view, rp, hit, pixel, sample, bounce, ray, throughput, radiance, pdf, shadow);
+  EXPECT_FALSE(shadow.valid);
+  return alive;
+}
+
 TEST(Material, ShadeHitEmitterAddsWeightedEmissionAndEnds) {
   Material m = make_material(MaterialKind::Emissive, vec3(0.0f));
   m.emission = vec3(4.0f, 2.0f, 1.0f);
   OneSphereScene scene(m);
   Ray ray{vec3(0.0f, 0.0f, 5.0f), vec3(0.0f, 0.0f, -1.0f)};
   vec3 throughput(0.5f, 0.25f, 1.0f), radiance(0.1f, 0.0f, 0.0f);
-  EXPECT_FALSE(shade_hit(scene.view, params(100), Hit{4.0f, 0, 0, 0.0f, 0.0f}, 0, 0, 0, ray, throughput, radiance));
+  EXPECT_FALSE(shade(scene.view, params(100), Hit{4.0f, 0, 0, 0.0f, 0.0f}, 0, 0, 0, ray, throughput, radiance));
   EXPECT_EQ(radiance, vec3(0.1f + 2.0f, 0.5f, 1.0f));
 }
 
@@ -355,7 +366,7 @@ TEST(Material, ShadeHitRussianRouletteIsUnbiased) {
     {
       Ray ray = start;
       vec3 radiance(0.0f);
-      ASSERT_TRUE(shade_hit(scene.view, params(100), hit, 0, 0, 0, ray, expected, radiance));
+      ASSERT_TRUE(shade(scene.view, params(100), hit, 0, 0, 0, ray, expected, radiance));
       EXPECT_EQ(expected, cs.throughput_in * cs.albedo);
       EXPECT_EQ(radiance, vec3(0.0f));
       EXPECT_GT(ray.dir.z, 0.0f);  // scattered back up, off the top of the sphere
@@ -368,7 +379,7 @@ TEST(Material, ShadeHitRussianRouletteIsUnbiased) {
     for (int i = 0; i < n; ++i) {
       Ray ray = start;
       vec3 t = cs.throughput_in, radiance(0.0f);
-      if (shade_hit(scene.view, params(0), hit, uint32_t(i), 0, 0, ray, t, radiance)) {
+      if (shade(scene.view, params(0), hit, uint32_t(i), 0, 0, ray, t, radiance)) {
         ++survived;
         for (int k = 0; k < 3; ++k) sum[k] += t[k];
         // A survivor carries exactly T / p.
@@ -390,7 +401,7 @@ TEST(Material, ShadeHitWithoutRouletteNeverEndsADiffusePath) {
   for (int i = 0; i < 10000; ++i) {
     Ray ray{vec3(0.0f, 0.0f, 5.0f), vec3(0.0f, 0.0f, -1.0f)};
     vec3 t(1.0f), radiance(0.0f);
-    ASSERT_TRUE(shade_hit(scene.view, params(8), Hit{4.0f, 0, 0, 0.0f, 0.0f}, uint32_t(i), 0, 3, ray, t, radiance));
+    ASSERT_TRUE(shade(scene.view, params(8), Hit{4.0f, 0, 0, 0.0f, 0.0f}, uint32_t(i), 0, 3, ray, t, radiance));
     ASSERT_EQ(t, vec3(0.05f));
   }
 }

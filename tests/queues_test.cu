@@ -84,11 +84,14 @@ TEST(WaveLayout, EveryArrayIsAlignedDisjointAndInsideTheBlock) {
 #define WT_TEST_RANGE(T, array, member) ranges.push_back({w.hits.array, capacity * sizeof(T)});
   WT_HIT_FIELDS(WT_TEST_RANGE)
 #undef WT_TEST_RANGE
+#define WT_TEST_RANGE(T, array, member) ranges.push_back({w.shadows.array, capacity * sizeof(T)});
+  WT_SHADOW_FIELDS(WT_TEST_RANGE)
+#undef WT_TEST_RANGE
   ranges.push_back({w.entries, capacity * sizeof(uint32_t)});
   ranges.push_back({w.selected, capacity * sizeof(uint32_t)});
   ranges.push_back({w.counters, sizeof(WaveCounters)});
   ranges.push_back({w.temp, temp});
-  EXPECT_EQ(ranges.size(), 2 * 11 + 5 + 4u);
+  EXPECT_EQ(ranges.size(), 2 * 12 + 5 + 11 + 4u);
   std::sort(ranges.begin(), ranges.end(), [](const Range& a, const Range& b) { return a.p < b.p; });
   for (size_t i = 0; i < ranges.size(); ++i) {
     const auto at = static_cast<const unsigned char*>(ranges[i].p);
@@ -100,11 +103,14 @@ TEST(WaveLayout, EveryArrayIsAlignedDisjointAndInsideTheBlock) {
 }
 
 TEST(WaveLayout, BytesGrowByTheDeclaredFieldsPerSlot) {
-  // Two path queues, the hit queue, and the entries and selected arrays; the fixed
-  // part (counters, temporaries, alignment) does not grow with the slots.
-  const size_t per_slot = 2 * PathQueue::kBytesPerSlot + HitQueue::kBytesPerSlot + 2 * sizeof(uint32_t);
-  EXPECT_EQ(PathQueue::kBytesPerSlot, 9 * sizeof(float) + 2 * sizeof(uint32_t));
+  // Two path queues, the hit queue, the shadow queue, and the entries and selected
+  // arrays; the fixed part (counters, temporaries, alignment) does not grow with the
+  // slots.
+  const size_t per_slot = 2 * PathQueue::kBytesPerSlot + HitQueue::kBytesPerSlot + ShadowQueue::kBytesPerSlot +
+                          2 * sizeof(uint32_t);
+  EXPECT_EQ(PathQueue::kBytesPerSlot, 10 * sizeof(float) + 2 * sizeof(uint32_t));
   EXPECT_EQ(HitQueue::kBytesPerSlot, 3 * sizeof(float) + 2 * sizeof(int32_t));
+  EXPECT_EQ(ShadowQueue::kBytesPerSlot, 10 * sizeof(float) + sizeof(uint32_t));
   const size_t a = wave_bytes(1 << 16, 4096), b = wave_bytes(1 << 17, 4096);
   EXPECT_EQ(b - a, (size_t(1) << 16) * per_slot);
   EXPECT_GE(a, (size_t(1) << 16) * per_slot + sizeof(WaveCounters) + 4096);

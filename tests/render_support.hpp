@@ -79,6 +79,8 @@ void expect_cuda_agrees_with_cpu(Render render, uint32_t seed) {
     EXPECT_LT(mad, 0.1 * independent) << kernel_name(k) << " (other seed: " << independent << ")";
     EXPECT_NEAR(mean(gpu.rgb), mean(cpu.rgb), 0.03 * mean(cpu.rgb)) << kernel_name(k);
     EXPECT_NEAR(static_cast<double>(gpu.rays), static_cast<double>(cpu.rays), 2e-3 * cpu.rays) << kernel_name(k);
+    EXPECT_NEAR(static_cast<double>(gpu.shadow_rays), static_cast<double>(cpu.shadow_rays), 2e-3 * cpu.shadow_rays)
+        << kernel_name(k);
   }
 }
 

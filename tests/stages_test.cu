@@ -329,6 +329,17 @@ TYPED_TEST(Stages, SortOrdersByKeyStablyAsAPermutation) {
 
 // One path per sphere of the stage scene, arriving head-on along -z, +x or -y,
 // after intersect has run on them on the host (so the hit records are real).
+// shade_one for scenes without emitters: no light sample comes out.
+template <class Scene>
+bool shade_path(uint32_t slot, const Scene& view, const RenderParams& rp, const PathQueue& q, const HitQueue& hits,
+                float* film, PathState& next) {
+  ShadowRay shadow;
+  uint32_t pixel;
+  const bool alive = shade_one(slot, 0, view, rp, q, hits, film, next, shadow, pixel);
+  EXPECT_FALSE(shadow.valid);
+  return alive;
+}
+
 struct ShadeCase {
   Scene scene = stage_scene();
   std::vector<ImageView> images;
@@ -366,7 +377,7 @@ TEST(ShadeStage, EachMaterialScattersAsItsDefinitionSays) {
   ShadeCase sc;
   PathState next[3];
   for (uint32_t i = 0; i < 3; ++i) {
-    ASSERT_TRUE(shade_one(i, 0, sc.view, kParams, sc.q, sc.hits, sc.film.data(), next[i])) << i;
+    ASSERT_TRUE(shade_path(i, sc.view, kParams, sc.q, sc.hits, sc.film.data(), next[i])) << i;
     EXPECT_EQ(next[i].bounce, 2u);
     EXPECT_EQ(next[i].path, 7 + i);
   }
@@ -390,7 +401,7 @@ TEST(ShadeStage, PathsAtTheDepthLimitEnd) {
   RenderParams shallow = kParams;
   shallow.depth = 2;  // the paths are at bounce 1: their next ray would be the third
   PathState next;
-  for (uint32_t i = 0; i < 3; ++i) EXPECT_FALSE(shade_one(i, 0, sc.view, shallow, sc.q, sc.hits, sc.film.data(), next));
+  for (uint32_t i = 0; i < 3; ++i) EXPECT_FALSE(shade_path(i, sc.view, shallow, sc.q, sc.hits, sc.film.data(), next));
 }
 
 TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
@@ -407,8 +418,8 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   Side::upload(w.hits.b2, sc.b2);
   Side::upload(w.selected, std::vector<uint32_t>{pack_entry(0, 2), pack_entry(0, 0), pack_entry(0, 1)});
   this->ex->launch(stage::kShade, 3,
-                   ShadeItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1], w.selected, 0,
-                             film});
+                   ShadeItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.queue[1], &w.counters->queued[1],
+                                        w.shadows, &w.counters->shadows, w.selected, 0, film});
   ASSERT_EQ(Side::download(&w.counters->queued[1], 1)[0], 3u);
   std::map<uint32_t, PathState> pushed;
   for (uint32_t i = 0; i < 3; ++i) {
@@ -417,7 +428,7 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
   }
   for (uint32_t i = 0; i < 3; ++i) {
     PathState expect;
-    ASSERT_TRUE(shade_one(i, 0, sc.view, kParams, sc.q, sc.hits, sc.film.data(), expect));
+    ASSERT_TRUE(shade_path(i, sc.view, kParams, sc.q, sc.hits, sc.film.data(), expect));
     ASSERT_EQ(pushed.count(expect.path), 1u);
     const PathState& got = pushed[expect.path];
     for (int k = 0; k < 3; ++k) {
@@ -427,6 +438,66 @@ TYPED_TEST(Stages, ShadePushesEachListedPathsNextBounceOnce) {
     }
     EXPECT_EQ(got.bounce, expect.bounce);
   }
+}
+
+// ---------- shadow ----------
+
+// Shadow rays from around the stage scene, in all directions and to all lengths:
+// the stage adds exactly the contributions of those that nothing blocks before
+// their tmax (brute force over the spheres decides), to their pixels; slots past
+// the queued count do nothing; then the rays are counted and the queue emptied.
+TYPED_TEST(Stages, ShadowAddsExactlyTheUnblockedSamples) {
+  using Side = TypeParam;
+  Scene scene = stage_scene();
+  typename Side::SceneData sd(scene, kParams.width, kParams.height);
+  const uint32_t n = 60, capacity = 64;
+  WaveView w = this->wave(capacity);
+  float* film = this->template array<float>(kPixels * 3);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> pos(-3.0f, 7.0f), length(0.5f, 12.0f);
+  std::normal_distribution<float> g;
+  std::vector<ShadowState> shadows;
+  std::vector<float> expect(kPixels * 3, 0.0f);
+  int blocked = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    ShadowState s;
+    s.ray = Ray{vec3(pos(rng), pos(rng) * 0.3f, pos(rng) * 0.3f), glm::normalize(vec3(g(rng), g(rng), g(rng)))};
+    if (i % 2 == 0) s.ray.dir = glm::normalize(-s.ray.origin + vec3(g(rng), g(rng), g(rng)) * 0.3f);  // toward the spheres
+    s.tmax = length(rng);
+    s.contribution = vec3(static_cast<float>(i + 1), 0.5f, 0.25f * static_cast<float>(i));
+    s.pixel = i % kPixels;
+    bool hit = false;
+    for (const SphereGeom& sg : scene.spheres) {
+      float t;
+      hit = hit || intersect_sphere(s.ray, vec3(sg.x, sg.y, sg.z), sg.w, kSphereTMin, s.tmax, t);
+    }
+    blocked += hit;
+    if (!hit) {
+      for (int k = 0; k < 3; ++k) expect[3 * s.pixel + k] += s.contribution[k];
+    }
+    shadows.push_back(s);
+  }
+  ASSERT_GT(blocked, 10);
+  ASSERT_LT(blocked, static_cast<int>(n) - 10);
+#define WT_TEST_FIELD(T, array, member)                                  \
+  {                                                                      \
+    std::vector<T> column;                                               \
+    for (const ShadowState& s : shadows) column.push_back(s.member);     \
+    Side::upload(w.shadows.array, column);                               \
+  }
+  WT_SHADOW_FIELDS(WT_TEST_FIELD)
+#undef WT_TEST_FIELD
+  WaveCounters counters{};
+  counters.shadows = n;
+  counters.shadow_rays = 1000;
+  Side::upload(w.counters, std::vector<WaveCounters>{counters});
+  this->ex->launch(stage::kShadow, capacity, ShadowItem<kAllKinds>{sd.view, w.shadows, w.counters, film});
+  this->ex->launch(stage::kShadow, 1, FinishShadowsItem{w.counters});
+  const auto image = Side::download(film, kPixels * 3);
+  for (size_t i = 0; i < image.size(); ++i) EXPECT_NEAR(image[i], expect[i], 1e-5f * (1.0f + expect[i])) << i;
+  const WaveCounters after = Side::download(w.counters, 1)[0];
+  EXPECT_EQ(after.shadow_rays, 1000u + n);
+  EXPECT_EQ(after.shadows, 0u);
 }
 
 }  // namespace

@@ -1,14 +1,27 @@
 // Sampling emitters from a shading point, and weighing two sampling strategies
 // against each other: the parts of next-event estimation that know nothing of the
-// scene's arrays. Densities are per unit solid angle at the shading point.
-//
-// Not yet called by the shading code: light sampling is being added in steps
-// (issue 8), and these are tested on their own first (tests/light_sampling_test.cpp).
+// scene's arrays (path.hpp puts them to work). Densities are per unit solid angle
+// at the shading point.
 #pragma once
 
 #include "wavetrace/config.hpp"
 
 namespace wt {
+
+// An emitter: a primitive of an instance whose material emits (an emissive sphere,
+// or one triangle of a placed mesh).
+struct LightRef {
+  int32_t instance;
+  int32_t prim;
+};
+
+// The power that picks an emitter among the scene's: its emission's mean over the
+// three channels times its area (the factor pi of a diffuse emitter's power is the
+// same for all and left out). The host builds the picking table from this, and the
+// shading code weighs emitters it hits by it, so both see the same probabilities.
+WT_HD WT_INLINE float light_power_of(const vec3& emission, float area) {
+  return (emission.x + emission.y + emission.z) * (1.0f / 3.0f) * area;
+}
 
 struct LightSample {
   vec3 dir;    // unit, from the shading point toward the light

@@ -30,6 +30,9 @@ enum RngDim : uint32_t {
   kDimFuzzB = 7,
   kDimLayer = 8,
   kDimRoulette = 9,
+  kDimLightPick = 10,
+  kDimLightA = 11,
+  kDimLightB = 12,
 };
 
 // Random numbers for one (seed, pixel, sample, bounce): `uniform(dim)` is in [0, 1).

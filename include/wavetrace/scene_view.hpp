@@ -3,6 +3,7 @@
 
 #include "wavetrace/camera.hpp"
 #include "wavetrace/geometry/geometry.hpp"
+#include "wavetrace/lights.hpp"
 #include "wavetrace/material.hpp"
 #include "wavetrace/sky.hpp"
 
@@ -16,6 +17,7 @@ struct RenderParams {
   int32_t depth;           // the most rays a path may trace
   int32_t roulette_depth;  // Russian roulette from this many bounces on
   uint32_t seed;
+  int32_t nee = 1;         // 1: sample the emitters at every diffuse hit (next-event estimation); 0: not
 };
 
 // Scene access through plain pointers (global memory on the GPU, host memory on
@@ -34,6 +36,10 @@ struct SceneView {
   const Material* materials;
   const Texture* textures;
   const ImageView* images;
+  const LightRef* lights;   // every emitter, for next-event estimation
+  const float* light_cdf;   // light_cdf[i]: the probability of picking lights 0..i (the last is 1)
+  int32_t light_total;
+  float light_power;        // the emitters' summed power (light_power_of), which picks them
   int32_t node_total;
   uint32_t kinds;  // the primitive kinds present (geometry.hpp), for choosing a kernel
   Sky sky;
@@ -52,6 +58,10 @@ struct SceneView {
   WT_HD const Material& material(uint32_t i) const { return materials[i]; }
   WT_HD const Texture* texture_array() const { return textures; }
   WT_HD const ImageView* image_array() const { return images; }
+  WT_HD int light_count() const { return light_total; }
+  WT_HD LightRef light(int i) const { return lights[i]; }
+  WT_HD float light_cdf_at(int i) const { return light_cdf[i]; }
+  WT_HD float total_light_power() const { return light_power; }
 };
 
 }  // namespace wt

@@ -217,7 +217,7 @@ int run_bench(const BenchOptions& options) {
 
   std::ostringstream csv;
   csv << "group,scene,width,height,spp,depth,kernel,status,seconds_median,seconds_min,seconds_max,rays,paths,"
-         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff\n";
+         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff,shadow_rays\n";
   for (const json& r : results["points"]) {
     csv << r["group"].get<std::string>() << "," << fs::path(r["scene"].get<std::string>()).filename().string() << ","
         << r["width"] << "," << r["height"] << "," << r["spp"] << "," << r["depth"] << ","
@@ -226,7 +226,8 @@ int run_bench(const BenchOptions& options) {
         << "," << r.value("rays", uint64_t(0)) << "," << r.value("paths", uint64_t(0)) << ","
         << r.value("m_rays_per_s", 0.0) << "," << r.value("m_paths_per_s", 0.0) << ","
         << r.value("rays_per_path", 0.0) << ","
-        << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << "\n";
+        << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << ","
+        << r.value("shadow_rays", uint64_t(0)) << "\n";
   }
   write_file((fs::path(options.out_dir) / "results.json").string(), results.dump(1) + "\n");
   write_file((fs::path(options.out_dir) / "results.csv").string(), csv.str());

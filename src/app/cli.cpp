@@ -17,6 +17,8 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
       ->check(CLI::IsMember(kernel_names()));
   cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
       ->check(CLI::IsMember(encoding_choices()));
+  cmd.add_flag_callback("--no-nee", [&job] { set_setting(job, SettingId::Nee, 0); },
+                        "no light sampling: pure path tracing (the same as --nee 0)");
   cmd.add_flag("--exr-float", job.exr_float, "OpenEXR output in 32-bit floats (default: half floats)");
   cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
 }

@@ -41,6 +41,7 @@ auto render_override(J& job, SettingId id) -> decltype(&job.width) {
     case SettingId::Depth: return &job.depth;
     case SettingId::RouletteDepth: return &job.roulette_depth;
     case SettingId::Seed: return &job.seed;
+    case SettingId::Nee: return &job.nee;
     default: return nullptr;
   }
 }

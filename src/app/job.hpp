@@ -17,7 +17,7 @@ struct Job {
   std::string output;
   std::string stats;  // empty: no stats file
   // The render settings (src/render/settings.hpp); unset: the scene's.
-  std::optional<int64_t> width, height, spp, depth, roulette_depth, seed;
+  std::optional<int64_t> width, height, spp, depth, roulette_depth, seed, nee;
   std::string backend = "auto";
   std::string kernel = "megakernel";
   int64_t warmup = 0;

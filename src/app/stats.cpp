@@ -49,6 +49,7 @@ nlohmann::json geometry_json(const Scene::Summary& g) {
 
 void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load) {
   j["rays"] = r.rays;
+  j["shadow_rays"] = r.shadow_rays;  // light sampling's, not in `rays`
   j["paths"] = r.paths;
   j["upload_seconds"] = r.upload_seconds;
   j["load_seconds"] = {{"parse", load.parse},
@@ -59,6 +60,7 @@ void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, 
                        {"upload", r.upload_seconds}};
   j["m_rays_per_s"] = seconds > 0 ? r.rays / seconds / 1e6 : 0.0;
   j["m_paths_per_s"] = seconds > 0 ? r.paths / seconds / 1e6 : 0.0;
+  j["m_shadow_rays_per_s"] = seconds > 0 ? r.shadow_rays / seconds / 1e6 : 0.0;
   j["rays_per_path"] = r.paths ? static_cast<double>(r.rays) / r.paths : 0.0;
   if (!r.stages.empty()) {
     nlohmann::json stages = nlohmann::json::object();

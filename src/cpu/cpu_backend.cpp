@@ -33,7 +33,7 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
   }
   out.samples = options.first_sample;
   const std::vector<SamplePass> passes = plan_passes(options, 1);
-  std::atomic<uint64_t> rays{0};
+  std::atomic<uint64_t> rays{0}, shadow_rays{0};
   std::atomic<int64_t> pixels_done{0};
   const int threads = thread_count(options.threads);
   auto t0 = Clock::now();
@@ -43,20 +43,23 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
     const SamplePass& pass = passes[p];
     // One row per chunk: whole rows keep the progress steady and the cache warm.
     parallel_for(pixels, rp.width, threads, [&](int64_t begin, int64_t end, int tid) {
-      uint32_t path_rays = 0;
-      uint64_t local_rays = 0;
+      uint32_t path_rays = 0, path_shadow_rays = 0;
+      uint64_t local_rays = 0, local_shadow_rays = 0;
       for (int64_t px = begin; px < end; ++px) {
         vec3 sum(0.0f);
         for (int32_t s = pass.first; s < pass.first + pass.count; ++s) {
           path_rays = 0;
-          sum += trace_path(view, rp, static_cast<uint32_t>(px), static_cast<uint32_t>(s), path_rays);
+          path_shadow_rays = 0;
+          sum += trace_path(view, rp, static_cast<uint32_t>(px), static_cast<uint32_t>(s), path_rays, path_shadow_rays);
           local_rays += path_rays;
+          local_shadow_rays += path_shadow_rays;
         }
         out.rgb[3 * px + 0] += sum.x;
         out.rgb[3 * px + 1] += sum.y;
         out.rgb[3 * px + 2] += sum.z;
       }
       const uint64_t total = rays.fetch_add(local_rays) + local_rays;
+      shadow_rays.fetch_add(local_shadow_rays);
       const int64_t done = pixels_done.fetch_add(end - begin) + (end - begin);
       if (last && options.progress && tid == 0) {  // only this thread touches last_report
         auto now = Clock::now();
@@ -75,6 +78,7 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
   }
   out.seconds = seconds_since(t0);
   out.rays = rays.load();
+  out.shadow_rays = shadow_rays.load();
   out.radiance = Radiance::SumOfSamples;
   return out;
 }

@@ -30,7 +30,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   DeviceBuffer<float> film(pixels * 3, kStage);
-  DeviceBuffer<unsigned long long> rays(1, kStage);
+  DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
 
   RenderResult out;
@@ -75,9 +75,10 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   };
   for (int i = 0; i < options.warmup; ++i) run(false);
   out.seconds = run(true);
-  unsigned long long counted = 0;
-  WT_CUDA(cudaMemcpy(&counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
-  out.rays = counted;
+  unsigned long long counted[2] = {0, 0};
+  WT_CUDA(cudaMemcpy(counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
+  out.rays = counted[0];
+  out.shadow_rays = counted[1];
   out.rgb = film.download(kStage);
   out.radiance = Radiance::SumOfSamples;
   return out;

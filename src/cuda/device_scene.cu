@@ -18,6 +18,8 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   uvs_.upload(scene.uvs, kStage);
   materials_.upload(scene.materials, kStage);
   textures_.upload(scene.textures, kStage);
+  lights_.upload(scene.lights, kStage);
+  light_cdf_.upload(scene.light_cdf, kStage);
 
   // Texels are fetched one by one (point sampling) and filtered by the shared
   // bilinear code, so the GPU computes exactly what the CPU computes.
@@ -57,6 +59,10 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   view_.materials = materials_.get();
   view_.textures = textures_.get();
   view_.images = images_.get();
+  view_.lights = lights_.get();
+  view_.light_cdf = light_cdf_.get();
+  view_.light_total = static_cast<int32_t>(scene.lights.size());
+  view_.light_power = scene.light_power;
   view_.node_total = static_cast<int32_t>(scene.nodes.size());
   view_.kinds = scene.primitive_kinds();
   view_.sky = scene.sky;

@@ -33,6 +33,8 @@ class DeviceScene {
   DeviceBuffer<Material> materials_;
   DeviceBuffer<Texture> textures_;
   DeviceBuffer<ImageView> images_;
+  DeviceBuffer<LightRef> lights_;
+  DeviceBuffer<float> light_cdf_;
   std::vector<cudaArray_t> arrays_;
   std::vector<cudaTextureObject_t> objects_;
   std::vector<ImageView> image_views_;

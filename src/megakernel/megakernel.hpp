@@ -11,7 +11,7 @@
 namespace wt::cuda {
 
 // Adds samples [first_sample, first_sample + samples) of every pixel to film (RGB
-// sums) and the rays they intersect to *rays.
+// sums), the path rays they intersect to rays[0] and the shadow rays to rays[1].
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
                        unsigned long long* rays, cudaStream_t stream);
 

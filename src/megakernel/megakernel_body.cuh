@@ -12,14 +12,15 @@ constexpr int kMegakernelBlockY = 8;
 template <uint32_t Kinds, class Scene>
 __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const RenderParams& rp, int first_sample,
                                                  int samples, float* film, unsigned long long* rays) {
+  // rays[0]: path rays; rays[1]: shadow rays.
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
-  uint32_t count = 0;
+  uint32_t count = 0, shadow_count = 0;
   if (x < rp.width && y < rp.height) {
     const uint32_t pixel = static_cast<uint32_t>(y) * rp.width + x;
     vec3 sum(0.0f);
     for (int s = first_sample; s < first_sample + samples; ++s) {
-      sum += trace_path<Kinds>(scene, rp, pixel, static_cast<uint32_t>(s), count);
+      sum += trace_path<Kinds>(scene, rp, pixel, static_cast<uint32_t>(s), count, shadow_count);
     }
     float* f = film + 3 * static_cast<size_t>(pixel);
     f[0] += sum.x;
@@ -28,9 +29,15 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
   }
   // One atomic per warp, not per ray: every lane reaches this point. The warp's sum
   // is taken in 64 bits, since 32 lanes of a long pass can pass 2^32 rays.
-  unsigned long long warp_total = count;
-  for (int offset = 16; offset > 0; offset /= 2) warp_total += __shfl_down_sync(0xffffffffu, warp_total, offset);
-  if ((threadIdx.x + threadIdx.y * blockDim.x) % 32 == 0 && warp_total) atomicAdd(rays, warp_total);
+  unsigned long long warp_total = count, warp_shadows = shadow_count;
+  for (int offset = 16; offset > 0; offset /= 2) {
+    warp_total += __shfl_down_sync(0xffffffffu, warp_total, offset);
+    warp_shadows += __shfl_down_sync(0xffffffffu, warp_shadows, offset);
+  }
+  if ((threadIdx.x + threadIdx.y * blockDim.x) % 32 == 0) {
+    if (warp_total) atomicAdd(rays, warp_total);
+    if (warp_shadows) atomicAdd(rays + 1, warp_shadows);
+  }
 }
 
 inline dim3 megakernel_grid(const RenderParams& rp) {

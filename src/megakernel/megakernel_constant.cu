@@ -19,8 +19,9 @@ __constant__ __align__(16) unsigned char c_pool[kPoolBytes];
 // Where each array starts in the pool.
 struct ConstantLayout {
   uint32_t nodes, instances, spheres, sphere_materials, triangles, triangle_shadings, triangle_materials, normals, uvs,
-      materials, textures, images;
-  int32_t node_total;
+      materials, textures, images, lights, light_cdf;
+  int32_t node_total, light_total;
+  float light_power;
 };
 
 struct ConstantScene {
@@ -47,6 +48,10 @@ struct ConstantScene {
   __device__ const Material& material(uint32_t i) const { return array<Material>(layout.materials)[i]; }
   __device__ const Texture* texture_array() const { return array<Texture>(layout.textures); }
   __device__ const ImageView* image_array() const { return array<ImageView>(layout.images); }
+  __device__ int light_count() const { return layout.light_total; }
+  __device__ LightRef light(int i) const { return array<LightRef>(layout.lights)[i]; }
+  __device__ float light_cdf_at(int i) const { return array<float>(layout.light_cdf)[i]; }
+  __device__ float total_light_power() const { return layout.light_power; }
 };
 
 ConstantScene g_scene{};  // host copy of the accessor, filled by upload_constant_scene
@@ -87,12 +92,16 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   cs.layout.materials = place(scene.materials);
   cs.layout.textures = place(scene.textures);
   cs.layout.images = place(images);
+  cs.layout.lights = place(scene.lights);
+  cs.layout.light_cdf = place(scene.light_cdf);
   if (pool.size() > kPoolBytes) {
     throw SceneError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
                      " bytes of constant memory; megakernel-constant holds at most " + std::to_string(kPoolBytes) +
                      " (use --kernel megakernel)");
   }
   cs.layout.node_total = device_view.node_total;
+  cs.layout.light_total = device_view.light_total;
+  cs.layout.light_power = device_view.light_power;
   cs.sky = device_view.sky;
   cs.camera = device_view.camera;
   WT_CUDA(cudaMemcpyToSymbol(c_pool, pool.data(), pool.size()), "constant upload");

@@ -15,6 +15,16 @@ struct PathState {
   vec3 throughput;
   uint32_t path;    // path index within its pass: pixel = path % pixels, sample = pass's first + path / pixels
   uint32_t bounce;  // rays this path has traced so far
+  float pdf;        // the last bounce's BSDF density (0: specular, or the camera), for MIS
+};
+
+// A light sample waiting for its shadow ray (path.hpp's ShadowRay, and the pixel
+// it lights).
+struct ShadowState {
+  Ray ray;
+  float tmax;
+  vec3 contribution;
+  uint32_t pixel;
 };
 
 // (element type, array, member of PathState)
@@ -22,13 +32,21 @@ struct PathState {
   X(float, ox, ray.origin.x) X(float, oy, ray.origin.y) X(float, oz, ray.origin.z)          \
   X(float, dx, ray.dir.x) X(float, dy, ray.dir.y) X(float, dz, ray.dir.z)                   \
   X(float, tr, throughput.x) X(float, tg, throughput.y) X(float, tb, throughput.z)          \
-  X(uint32_t, path, path) X(uint32_t, bounce, bounce)
+  X(uint32_t, path, path) X(uint32_t, bounce, bounce) X(float, pdf, pdf)
 
 // (element type, array, member of Hit): the closest hit of each slot's ray.
 #define WT_HIT_FIELDS(X) \
   X(float, t, t) X(int32_t, instance, instance) X(int32_t, prim, prim) X(float, b1, b1) X(float, b2, b2)
 
+// (element type, array, member of ShadowState)
+#define WT_SHADOW_FIELDS(X)                                                              \
+  X(float, ox, ray.origin.x) X(float, oy, ray.origin.y) X(float, oz, ray.origin.z)     \
+  X(float, dx, ray.dir.x) X(float, dy, ray.dir.y) X(float, dz, ray.dir.z)              \
+  X(float, tmax, tmax) X(float, cr, contribution.x) X(float, cg, contribution.y)        \
+  X(float, cb, contribution.z) X(uint32_t, pixel, pixel)
+
 WT_SOA_QUEUE(PathQueue, PathState, WT_PATH_FIELDS);
+WT_SOA_QUEUE(ShadowQueue, ShadowState, WT_SHADOW_FIELDS);
 WT_SOA_QUEUE(HitQueue, Hit, WT_HIT_FIELDS);
 
 // Sort entries pack the material sort key above the slot index, so one 32-bit

@@ -17,6 +17,9 @@ struct WaveCounters {
   uint32_t next_path;  // first path index not yet generated
   uint32_t hits;       // entries compact kept this bounce
   uint64_t rays;       // rays intersected, all bounces
+  uint32_t shadows;    // shadow rays shade queued this bounce
+  uint32_t unused;
+  uint64_t shadow_rays;  // shadow rays traced, all bounces
 };
 
 // Paths live in slots [0, live) once generate has filled the free slots.
@@ -30,6 +33,7 @@ struct WaveView {
   uint32_t capacity = 0;
   PathQueue queue[2];  // the bounce being traced, and the next one shade pushes into
   HitQueue hits;
+  ShadowQueue shadows;           // shade's light samples, one a slot at the most
   uint32_t* entries = nullptr;   // intersect's sort entries; the sort's second buffer
   uint32_t* selected = nullptr;  // compact's output: the entries of rays that hit
   WaveCounters* counters = nullptr;
@@ -45,6 +49,7 @@ inline WaveView lay_out_wave(unsigned char* base, size_t capacity, size_t temp_b
   w.capacity = static_cast<uint32_t>(capacity);
   for (PathQueue& q : w.queue) q = PathQueue::take(arena, capacity);
   w.hits = HitQueue::take(arena, capacity);
+  w.shadows = ShadowQueue::take(arena, capacity);
   w.entries = arena.take<uint32_t>(capacity);
   w.selected = arena.take<uint32_t>(capacity);
   w.counters = arena.take<WaveCounters>(1);

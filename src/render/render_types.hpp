@@ -70,6 +70,7 @@ struct RenderResult {
   int32_t samples = 0;       // samples per pixel the film sums (from sample 0)
   bool interrupted = false;  // after_pass stopped the render before its last sample
   uint64_t rays = 0;   // every ray this render intersected, counted once
+  uint64_t shadow_rays = 0;  // the shadow rays of light sampling, apart from `rays`
   uint64_t paths = 0;  // pixels x samples this render traced
   double seconds = 0;  // the render alone: CUDA events on the GPU, wall clock on the CPU
   double upload_seconds = 0;

@@ -16,6 +16,8 @@ const std::vector<Setting>& settings() {
       {SettingId::RouletteDepth, "roulette_depth", "--roulette-depth", SettingType::Int32, 0, kMaxRouletteDepth,
        d.roulette_depth, "Russian roulette from this many bounces on"},
       {SettingId::Seed, "seed", "--seed", SettingType::UInt32, 0, UINT32_MAX, d.seed, "render seed"},
+      {SettingId::Nee, "nee", "--nee", SettingType::Int32, 0, 1, d.nee,
+       "1: sample the emitters at diffuse hits (next-event estimation, weighted by MIS); 0: pure path tracing"},
       {SettingId::Warmup, "warmup", "--warmup", SettingType::Int32, 0, 100, 0, "untimed renders before the timed one"},
       {SettingId::WaveSize, "wave_size", "--wave-size", SettingType::Int64, kMinWaveSlots,
        static_cast<int64_t>(kMaxWaveSize), 0, "wavefront path slots (default: chosen from free memory)"},
@@ -29,8 +31,9 @@ const std::vector<Setting>& settings() {
 const Setting& setting(SettingId id) { return settings()[static_cast<size_t>(id)]; }
 
 const std::vector<SettingId>& render_settings() {
-  static const std::vector<SettingId> ids = {SettingId::Width, SettingId::Height,        SettingId::Spp,
-                                             SettingId::Depth, SettingId::RouletteDepth, SettingId::Seed};
+  static const std::vector<SettingId> ids = {SettingId::Width,         SettingId::Height, SettingId::Spp,
+                                             SettingId::Depth,         SettingId::RouletteDepth,
+                                             SettingId::Seed,          SettingId::Nee};
   return ids;
 }
 
@@ -42,6 +45,7 @@ int64_t get_param(const RenderParams& p, SettingId id) {
     case SettingId::Depth: return p.depth;
     case SettingId::RouletteDepth: return p.roulette_depth;
     case SettingId::Seed: return p.seed;
+    case SettingId::Nee: return p.nee;
     default: throw std::logic_error(std::string("not a render parameter: ") + setting(id).key);
   }
 }
@@ -54,6 +58,7 @@ void set_param(RenderParams& p, SettingId id, int64_t value) {
     case SettingId::Depth: p.depth = static_cast<int32_t>(value); break;
     case SettingId::RouletteDepth: p.roulette_depth = static_cast<int32_t>(value); break;
     case SettingId::Seed: p.seed = static_cast<uint32_t>(value); break;
+    case SettingId::Nee: p.nee = static_cast<int32_t>(value); break;
     default: throw std::logic_error(std::string("not a render parameter: ") + setting(id).key);
   }
 }

@@ -12,7 +12,7 @@
 
 namespace wt {
 
-enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Warmup, WaveSize, Threads, CheckpointEvery };
+enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Nee, Warmup, WaveSize, Threads, CheckpointEvery };
 
 enum class SettingType { Int32, UInt32, Int64 };
 
@@ -30,7 +30,7 @@ struct Setting {
 const std::vector<Setting>& settings();
 const Setting& setting(SettingId id);
 
-// The settings a RenderParams holds (width .. seed): a scene's `render` section
+// The settings a RenderParams holds (width .. nee): a scene's `render` section
 // and a bench configuration give these.
 const std::vector<SettingId>& render_settings();
 int64_t get_param(const RenderParams& p, SettingId id);

@@ -93,6 +93,11 @@ struct Scene {
   // node array (the top level first, then the spheres' and each mesh's tree).
   std::vector<Instance> instances;
   std::vector<BvhNode> nodes;
+  // The emitters (every emissive primitive of every instance, with the material
+  // it shades with) and the table that picks them by power (lights.hpp).
+  std::vector<LightRef> lights;
+  std::vector<float> light_cdf;
+  float light_power = 0.0f;
   BvhStats top_level_bvh;
   BvhStats sphere_bvh;
   LoadTimes load_times;

@@ -73,9 +73,12 @@ Aabb world_box(const Aabb& object, const Placement& p) {
 
 }  // namespace
 
+void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh);
+
 void build_bvh(Scene& scene) {
   scene.nodes.clear();
   scene.instances.clear();
+  build_lights(scene, {});
   if (scene.placements.empty()) return;
   const BvhBuildOptions blas_options;
   BvhBuildOptions tlas_options;
@@ -152,6 +155,62 @@ void build_bvh(Scene& scene) {
     in.material = p.material;
     in.identity = p.identity ? 1u : 0u;
   }
+  std::vector<int32_t> instance_mesh(top.order.size());
+  for (size_t i = 0; i < top.order.size(); ++i) instance_mesh[i] = scene.placements[top.order[i]].mesh;
+  build_lights(scene, instance_mesh);
+}
+
+// The emitters of the built instances (instance_mesh[i]: instance i's mesh, or
+// kSpheres), with the table that picks them by power. Their power is computed in
+// float from world-space shapes as the shading code computes it (path.hpp,
+// light_pick_probability), so that both see the same probabilities.
+void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
+  scene.lights.clear();
+  scene.light_cdf.clear();
+  scene.light_power = 0.0f;
+  std::vector<float> power;
+  auto add = [&](int32_t instance, uint32_t prim, uint32_t material, float area) {
+    // (Scenes built by hand in the tests may leave out materials they never shade.)
+    if (material >= scene.materials.size()) return;
+    const Material& m = scene.materials[material];
+    if (m.kind != MaterialKind::Emissive) return;
+    const float p = light_power_of(m.emission, area);
+    if (!(p > 0.0f)) return;
+    scene.lights.push_back(LightRef{instance, static_cast<int32_t>(prim)});
+    power.push_back(p);
+  };
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& in = scene.instances[i];
+    const int32_t index = static_cast<int32_t>(i);
+    if (in.kind == PrimitiveKind::Sphere) {
+      for (size_t p = 0; p < scene.spheres.size(); ++p) {
+        const float r = scene.spheres[p].w;
+        add(index, static_cast<uint32_t>(p), in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.sphere_material[p],
+            4.0f * kPi * r * r);
+      }
+      continue;
+    }
+    const SceneMesh& mesh = scene.meshes.at(static_cast<size_t>(instance_mesh.at(i)));
+    for (uint32_t t = mesh.first_triangle; t < mesh.first_triangle + mesh.triangle_count; ++t) {
+      vec3 a = scene.triangles[t].corner(0), b = scene.triangles[t].corner(1), c = scene.triangles[t].corner(2);
+      if (!in.identity) {
+        a = in.world_from_object.point(a);
+        b = in.world_from_object.point(b);
+        c = in.world_from_object.point(c);
+      }
+      add(index, t, in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.triangle_material[t],
+          0.5f * glm::length(glm::cross(b - a, c - a)));
+    }
+  }
+  double total = 0.0;
+  for (float p : power) total += p;
+  scene.light_power = static_cast<float>(total);
+  double running = 0.0;
+  for (float p : power) {
+    running += p;
+    scene.light_cdf.push_back(static_cast<float>(running / total));
+  }
+  if (!scene.light_cdf.empty()) scene.light_cdf.back() = 1.0f;
 }
 
 size_t Scene::instanced_triangles() const {
@@ -170,7 +229,8 @@ size_t bytes_of(const std::vector<T>& v) {
 }  // namespace
 
 size_t Scene::device_bytes() const {
-  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(spheres) + bytes_of(sphere_material) +
+  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(lights) + bytes_of(light_cdf) + bytes_of(spheres) +
+                 bytes_of(sphere_material) +
                  bytes_of(triangles) + bytes_of(triangle_shading) + bytes_of(triangle_material) + bytes_of(normals) +
                  bytes_of(uvs) + bytes_of(materials) + bytes_of(textures);
   for (const Image& im : images) total += bytes_of(im.texels);

@@ -154,6 +154,10 @@ SceneView host_view(const Scene& scene, int width, int height, std::vector<Image
   v.materials = scene.materials.data();
   v.textures = scene.textures.data();
   v.images = image_views.data();
+  v.lights = scene.lights.data();
+  v.light_cdf = scene.light_cdf.data();
+  v.light_total = static_cast<int32_t>(scene.lights.size());
+  v.light_power = scene.light_power;
   v.node_total = static_cast<int32_t>(scene.nodes.size());
   v.kinds = scene.primitive_kinds();
   v.sky = scene.sky;

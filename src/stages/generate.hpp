@@ -19,6 +19,7 @@ WT_HD WT_INLINE PathState start_path(uint32_t slot, uint32_t queued, uint32_t ne
   s.path = next_path + (slot - queued);
   s.bounce = 0;
   s.throughput = vec3(1.0f);
+  s.pdf = 0.0f;
   s.ray = primary_ray(scene, rp, s.path % pixels, first_sample + s.path / pixels);
   return s;
 }

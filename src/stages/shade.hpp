@@ -1,6 +1,7 @@
 // shade: scatters each listed path (in sorted order, so a warp mostly runs one
-// material's code), adds emission to the film, and pushes survivors into the other
-// queue, which leaves the next queue dense.
+// material's code), adds emission to the film, queues its light sample for the
+// shadow stage, and pushes survivors into the other queue, which leaves the next
+// queue dense.
 #pragma once
 
 #include "queues/push.hpp"
@@ -14,14 +15,16 @@ namespace wt {
 // `first_sample`); on true `next` is the path's next bounce.
 // Kinds: the primitive kinds the scene holds (a superset shades the same).
 template <uint32_t Kinds = kAllKinds, class Scene>
+// `shadow` (with shadow.valid) is the light sample taken there, for `pixel`.
 WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene& scene, const RenderParams& rp,
-                               const PathQueue& q, const HitQueue& hits, float* film, PathState& next) {
+                               const PathQueue& q, const HitQueue& hits, float* film, PathState& next,
+                               ShadowRay& shadow, uint32_t& pixel) {
   PathState s = q.load(slot);
   const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
-  const uint32_t pixel = s.path % pixels;
+  pixel = s.path % pixels;
   vec3 radiance(0.0f);
   bool alive = shade_hit<Kinds>(scene, rp, hits.load(slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
-                         s.throughput, radiance);
+                                s.throughput, radiance, s.pdf, shadow);
   if (radiance.x != 0.0f || radiance.y != 0.0f || radiance.z != 0.0f) accumulate_one(film, pixel, radiance);
   s.bounce += 1;
   next = s;
@@ -37,16 +40,52 @@ struct ShadeItem {
   HitQueue hits;
   PathQueue next_queue;
   uint32_t* next_count;
+  ShadowQueue shadows;
+  uint32_t* shadow_count;
   const uint32_t* list;
   uint32_t first_sample;  // of this pass
   float* film;
 
   WT_HD void operator()(uint32_t i) const {
     PathState next;
-    const bool alive = shade_one<Kinds>(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next);
-    // Every item reaches the push, so that a warp reserves its slots with one atomic.
+    ShadowRay shadow;
+    uint32_t pixel;
+    const bool alive =
+        shade_one<Kinds>(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next, shadow, pixel);
+    // Every item reaches the pushes, so that a warp reserves its slots with one atomic.
     const uint32_t slot = push_slot(next_count, alive);
     if (alive) next_queue.store(slot, next);
+    const uint32_t shadow_slot = push_slot(shadow_count, shadow.valid);
+    if (shadow.valid) shadows.store(shadow_slot, ShadowState{shadow.ray, shadow.tmax, shadow.contribution, pixel});
+  }
+};
+
+// shadow: each queued light sample's shadow ray, traced until anything blocks it;
+// an unblocked one adds its contribution to the film. Launched over the wave's
+// capacity: the count is on the device, where shade left it.
+template <uint32_t Kinds>
+struct ShadowItem {
+  // On the GPU, registers bounded as intersect's are (stages/intersect.hpp).
+  static constexpr int kMinBlocksPerSm = Kinds == kSpheresOnly ? 0 : 4;
+  SceneView scene;
+  ShadowQueue shadows;
+  const WaveCounters* counters;
+  float* film;
+
+  WT_HD void operator()(uint32_t i) const {
+    if (i >= counters->shadows) return;
+    const ShadowState s = shadows.load(i);
+    if (!occluded<Kinds>(scene, s.ray, s.tmax)) accumulate_one(film, s.pixel, s.contribution);
+  }
+};
+
+// One item after the shadow stage: counts its rays and empties the queue.
+struct FinishShadowsItem {
+  WaveCounters* counters;
+
+  WT_HD void operator()(uint32_t) const {
+    counters->shadow_rays += counters->shadows;
+    counters->shadows = 0;
   }
 };
 

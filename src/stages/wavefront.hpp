@@ -1,6 +1,8 @@
 // The wavefront, written once for every backend over an executor that runs named
 // stages: per bounce (generate +) intersect -> compact -> (readback) -> sort ->
-// shade, with path regeneration keeping the wave full while paths remain. The host
+// shade -> shadow (the light samples shade queued, where the scene has emitters and
+// light sampling is on), with path regeneration keeping the wave full while paths
+// remain. The host
 // reads the counters back once per bounce (after compact), which tells it how many
 // entries to sort and shade and when every path is done.
 //
@@ -40,7 +42,8 @@ constexpr Stage kCompact{1, "compact"};
 constexpr Stage kReadback{2, "readback"};
 constexpr Stage kSort{3, "sort"};
 constexpr Stage kShade{4, "shade"};
-constexpr std::array<Stage, 5> kAll = {kIntersect, kCompact, kReadback, kSort, kShade};
+constexpr Stage kShadow{5, "shadow"};
+constexpr std::array<Stage, 6> kAll = {kIntersect, kCompact, kReadback, kSort, kShade, kShadow};
 }  // namespace stage
 
 // Bytes a wave of `capacity` slots takes on the executor's memory.
@@ -56,6 +59,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
                               int64_t capacity) {
   const RenderParams& rp = options.params;
   const bool sorted = options.kernel == Kernel::Wavefront;
+  const bool light_sampling = rp.nee != 0 && scene.light_total > 0;
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
   // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
   // ends with the wave draining, which a full wave's regeneration otherwise hides.
@@ -80,7 +84,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       ex.zero(film, film_floats * sizeof(float));
     }
     std::vector<uint64_t> live_per_bounce;
-    uint64_t rays = 0, paths_done = 0;
+    uint64_t rays = 0, shadow_rays = 0, paths_done = 0;
     out.samples = options.first_sample;
     out.interrupted = false;
     ex.start_timer();
@@ -107,7 +111,12 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         with_kinds(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kShade, c.hits,
                     ShadeItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur],
-                                                      &w.counters->queued[1 - cur], list, first, film});
+                                                      &w.counters->queued[1 - cur], w.shadows, &w.counters->shadows,
+                                                      list, first, film});
+          if (light_sampling && c.hits > 0) {
+            ex.launch(stage::kShadow, c.hits, ShadowItem<decltype(kinds)::value>{scene, w.shadows, w.counters, film});
+            ex.launch(stage::kShadow, 1, FinishShadowsItem{w.counters});
+          }
         });
         if (last && options.progress) {
           options.progress(static_cast<double>(paths_done + c.next_path - c.queued[cur]) / all_paths, rays + c.rays,
@@ -115,6 +124,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         }
         if (c.hits == 0 && c.next_path >= total) {
           rays += c.rays;
+          shadow_rays += c.shadow_rays;
           break;
         }
       }
@@ -128,6 +138,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
     }
     out.seconds = ex.stop_timer();
     out.rays = rays;
+    out.shadow_rays = shadow_rays;
     out.paths = paths_done;
     const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
     out.stages.clear();

@@ -66,7 +66,10 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
 // instances; entering one moves the ray into the instance's object space (where t
 // measures the same distances: the direction is transformed, not renormalised) and
 // pushes the mark of the way back.
-template <uint32_t Kinds = kAllKinds, class Geometry>
+//
+// AnyHit: return the first hit found (not the closest): enough to know that the
+// segment to tmax is blocked, which is what a shadow ray asks.
+template <uint32_t Kinds = kAllKinds, bool AnyHit = false, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   if (g.node_count() == 0) return hit;
@@ -107,6 +110,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
     }
     if (n.count > 0) {
       intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
+      if (AnyHit && hit.prim >= 0) return hit;
     } else {
       const int a = n.left_or_first;
       const BvhNode na = g.node(a), nb = g.node(a + 1);
