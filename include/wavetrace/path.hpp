@@ -8,6 +8,10 @@ namespace wt {
 
 constexpr float kRayTMax = 3.0e38f;
 
+// What the path functions are compiled for unless a kernel says otherwise: every
+// primitive kind, and light sampling.
+constexpr uint32_t kEverything = kAllKinds | kLightSampling;
+
 // Kinds: the primitive kinds the scene holds (geometry.hpp), or a superset.
 template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE Hit intersect_scene(const Scene& scene, const Ray& ray) {
@@ -48,7 +52,7 @@ WT_HD WT_INLINE void world_triangle(const Scene& scene, const Instance& in, int 
 template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE float light_pick_probability(const Scene& scene, const vec3& emission, int instance, int prim) {
   float area;
-  if (Kinds == kSpheresOnly || scene.instance(instance).kind == PrimitiveKind::Sphere) {
+  if (spheres_only(Kinds) || scene.instance(instance).kind == PrimitiveKind::Sphere) {
     const SphereGeom sg = scene.sphere(prim);
     area = 4.0f * kPi * sg.w * sg.w;
   } else {
@@ -68,7 +72,7 @@ template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE float light_density(const Scene& scene, const vec3& emission, int instance, int prim,
                                     const vec3& from, const vec3& dir, float dist) {
   float pdf;
-  if (Kinds == kSpheresOnly || scene.instance(instance).kind == PrimitiveKind::Sphere) {
+  if (spheres_only(Kinds) || scene.instance(instance).kind == PrimitiveKind::Sphere) {
     const SphereGeom sg = scene.sphere(prim);
     pdf = sphere_light_pdf(vec3(sg.x, sg.y, sg.z), sg.w, from);
   } else {
@@ -122,7 +126,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, co
   const LightRef light = scene.light(pick_light(scene, rng.uniform(kDimLightPick), pick));
   if (!(pick > 0.0f)) return out;
   LightSample s;
-  if (Kinds == kSpheresOnly || scene.instance(light.instance).kind == PrimitiveKind::Sphere) {
+  if (spheres_only(Kinds) || scene.instance(light.instance).kind == PrimitiveKind::Sphere) {
     const SphereGeom sg = scene.sphere(light.prim);
     s = sample_sphere_light(vec3(sg.x, sg.y, sg.z), sg.w, sp.p, rng.uniform(kDimLightA), rng.uniform(kDimLightB));
   } else {
@@ -158,16 +162,17 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, co
 // bounce's BSDF density, 0 after a specular bounce or the camera), samples a light
 // (`shadow`), scatters, and plays Russian roulette. On true the path goes on along
 // `ray`, with `throughput` and `pdf` updated.
-template <uint32_t Kinds = kAllKinds, class Scene>
+template <uint32_t Kinds = kEverything, class Scene>
 WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const Hit& hit, uint32_t pixel,
                                uint32_t sample, uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance,
                                float& pdf, ShadowRay& shadow) {
   shadow.valid = false;
   const Material& m = scene.material(material_index<Kinds>(scene, hit));
-  const bool nee = rp.nee != 0 && scene.light_count() > 0;
+  constexpr bool kSampleLights = (Kinds & kLightSampling) != 0;
+  const bool nee = kSampleLights && rp.nee != 0 && scene.light_count() > 0;
   if (m.kind == MaterialKind::Emissive) {
     float w = 1.0f;
-    if (nee && pdf > 0.0f) {
+    if (kSampleLights && nee && pdf > 0.0f) {
       w = power_heuristic(pdf, light_density<Kinds>(scene, m.emission, hit.instance, hit.prim, ray.origin, ray.dir,
                                                     hit.t));
     }
@@ -180,7 +185,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
-  if (nee && m.kind == MaterialKind::Lambertian && static_cast<int>(bounce) + 1 < rp.depth) {
+  if (kSampleLights && nee && m.kind == MaterialKind::Lambertian && static_cast<int>(bounce) + 1 < rp.depth) {
     shadow = sample_light<Kinds>(scene, m, sp, facing_n, throughput, rng);
   }
   vec3 attenuation;
@@ -200,7 +205,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
 
 // The radiance of path (pixel, sample); `rays` grows by every path ray intersected,
 // `shadow_rays` by every shadow ray traced.
-template <uint32_t Kinds = kAllKinds, class Scene>
+template <uint32_t Kinds = kEverything, class Scene>
 WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample,
                                 uint32_t& rays, uint32_t& shadow_rays) {
   Ray ray = primary_ray(scene, rp, pixel, sample);
@@ -217,7 +222,7 @@ WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint
     const bool alive =
         shade_hit<Kinds>(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance, pdf,
                          shadow);
-    if (shadow.valid) {
+    if ((Kinds & kLightSampling) && shadow.valid) {
       ++shadow_rays;
       if (!occluded<Kinds>(scene, shadow.ray, shadow.tmax)) radiance += shadow.contribution;
     }

@@ -14,7 +14,9 @@ __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
                        unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
-  with_kinds(scene.kinds, [&](auto kinds) {
+  // Light sampling's code is compiled in only where the scene has emitters to sample.
+  const uint32_t kinds_and_lights = scene.kinds | (rp.nee != 0 && scene.light_total > 0 ? kLightSampling : 0u);
+  with_kinds(kinds_and_lights, [&](auto kinds) {
     megakernel_global<decltype(kinds)::value><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
   });
   WT_CUDA_LAUNCHED("megakernel_global", "megakernel");

@@ -42,7 +42,7 @@ struct IntersectItem {
   // (cuda/executor.cuh): their traversal waits on memory, and the occupancy this
   // buys traces the mesh scenes 5-6% faster than the 69 registers it takes
   // unbounded. Spheres alone need 44 and keep the unbounded kernel.
-  static constexpr int kMinBlocksPerSm = Kinds == kSpheresOnly ? 0 : 4;
+  static constexpr int kMinBlocksPerSm = spheres_only(Kinds) ? 0 : 4;
   SceneView scene;
   RenderParams rp;
   PathQueue queue;

@@ -14,7 +14,7 @@ namespace wt {
 // Scatters the path in slot `slot` (of the pass whose first sample is
 // `first_sample`); on true `next` is the path's next bounce.
 // Kinds: the primitive kinds the scene holds (a superset shades the same).
-template <uint32_t Kinds = kAllKinds, class Scene>
+template <uint32_t Kinds = kEverything, class Scene>
 // `shadow` (with shadow.valid) is the light sample taken there, for `pixel`.
 WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene& scene, const RenderParams& rp,
                                const PathQueue& q, const HitQueue& hits, float* film, PathState& next,
@@ -66,7 +66,7 @@ struct ShadeItem {
 template <uint32_t Kinds>
 struct ShadowItem {
   // On the GPU, registers bounded as intersect's are (stages/intersect.hpp).
-  static constexpr int kMinBlocksPerSm = Kinds == kSpheresOnly ? 0 : 4;
+  static constexpr int kMinBlocksPerSm = spheres_only(Kinds) ? 0 : 4;
   SceneView scene;
   ShadowQueue shadows;
   const WaveCounters* counters;

@@ -60,6 +60,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const RenderParams& rp = options.params;
   const bool sorted = options.kernel == Kernel::Wavefront;
   const bool light_sampling = rp.nee != 0 && scene.light_total > 0;
+  const uint32_t shade_kinds = scene.kinds | (light_sampling ? kLightSampling : 0u);
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
   // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
   // ends with the wave draining, which a full wave's regeneration otherwise hides.
@@ -93,7 +94,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       const uint32_t first = static_cast<uint32_t>(pass.first);
       ex.zero(w.counters, sizeof(WaveCounters));
       for (int cur = 0;; cur = 1 - cur) {
-        with_kinds(scene.kinds, [&](auto kinds) {
+        with_kinds<false>(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
                     IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, first,
                                            slots, film});
@@ -108,7 +109,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         if (sorted && c.hits > 0) {
           list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
         }
-        with_kinds(scene.kinds, [&](auto kinds) {
+        with_kinds(shade_kinds, [&](auto kinds) {
           ex.launch(stage::kShade, c.hits,
                     ShadeItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur],
                                                       &w.counters->queued[1 - cur], w.shadows, &w.counters->shadows,

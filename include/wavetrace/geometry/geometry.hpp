@@ -28,12 +28,30 @@ constexpr uint32_t kind_bit(PrimitiveKind k) { return 1u << static_cast<uint32_t
 constexpr uint32_t kSpheresOnly = kind_bit(PrimitiveKind::Sphere);
 constexpr uint32_t kAllKinds = kind_bit(PrimitiveKind::Sphere) | kind_bit(PrimitiveKind::Triangle);
 
-// The one choice of kernel by a scene's kinds (host side): calls f with the set a
-// kernel is compiled for, as a std::integral_constant: spheres alone, or all kinds.
-template <class F>
+// Not a primitive kind: a kernel compiled with light sampling (path.hpp). Scenes
+// without emitters, and renders with it off, run kernels without its code and
+// registers.
+constexpr uint32_t kLightSampling = 1u << 31;
+
+// Whether a kernel compiled for `kinds` serves spheres alone.
+constexpr bool spheres_only(uint32_t kinds) { return (kinds & ~kLightSampling) == kSpheresOnly; }
+
+// The one choice of kernel by a scene's kinds, and light sampling's bit (host side):
+// calls f with the set a kernel is compiled for, as a std::integral_constant:
+// spheres alone or all kinds, each with light sampling or without. Kernels that
+// never sample lights (intersect) say Lights = false and are compiled twice, not
+// four times.
+template <bool Lights = true, class F>
 inline void with_kinds(uint32_t scene_kinds, F&& f) {
-  if (scene_kinds == kSpheresOnly) {
-    f(std::integral_constant<uint32_t, kSpheresOnly>{});
+  const bool lights = Lights && (scene_kinds & kLightSampling) != 0;
+  if (spheres_only(scene_kinds)) {
+    if (lights) {
+      f(std::integral_constant<uint32_t, kSpheresOnly | (Lights ? kLightSampling : 0u)>{});
+    } else {
+      f(std::integral_constant<uint32_t, kSpheresOnly>{});
+    }
+  } else if (lights) {
+    f(std::integral_constant<uint32_t, kAllKinds | (Lights ? kLightSampling : 0u)>{});
   } else {
     f(std::integral_constant<uint32_t, kAllKinds>{});
   }
@@ -153,7 +171,7 @@ WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
 // The material a hit shades with: the instance's override, or the primitive's own.
 template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD WT_INLINE uint32_t material_index(const Geometry& g, const Hit& hit) {
-  if (Kinds == kSpheresOnly) return g.sphere_material(hit.prim);  // spheres take no override
+  if (spheres_only(Kinds)) return g.sphere_material(hit.prim);  // spheres take no override
   const Instance& in = g.instance(hit.instance);
   if (in.material >= 0) return static_cast<uint32_t>(in.material);
   switch (in.kind) {
@@ -216,7 +234,7 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
 // The surface at a hit of `ray` (in world space).
 template <uint32_t Kinds = kAllKinds, class Geometry>
 WT_HD WT_INLINE SurfacePoint surface_at(const Geometry& g, const Ray& ray, const Hit& hit) {
-  if (Kinds == kSpheresOnly) return sphere_surface(g.sphere(hit.prim), ray, hit.t);
+  if (spheres_only(Kinds)) return sphere_surface(g.sphere(hit.prim), ray, hit.t);
   const Instance& in = g.instance(hit.instance);
   switch (in.kind) {
     case PrimitiveKind::Sphere:
