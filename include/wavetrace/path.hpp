@@ -115,11 +115,17 @@ constexpr float kShadowShorten = 1e-4f;
 
 // Next-event estimation at a diffuse hit: one emitter picked by power, one point on
 // it, and its contribution weighted against the BSDF's sampling of the same
-// direction (the power heuristic). Specular, glossy and layered materials are
-// not light-sampled; the paths they scatter count what they hit in full.
+// direction (the power heuristic). Lambertian surfaces and the diffuse base of
+// coated ones are light-sampled; specular and glossy ones (dielectric, metal, a
+// coat's mirror reflection) are not, and the paths they scatter count what they
+// hit in full.
+//
+// `lobe`: the share of the surface's reflection that is diffuse (1 for Lambertian;
+// 1 - Fresnel for a coat over a diffuse base), which scales both the BSDF and the
+// density with which the BSDF samples the direction.
 template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, const SurfacePoint& sp,
-                                       const vec3& facing_n, const vec3& throughput, const Rng& rng) {
+                                       const vec3& facing_n, float lobe, const vec3& throughput, const Rng& rng) {
   ShadowRay out{};
   out.valid = false;
   float pick;
@@ -150,8 +156,8 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, co
   // when a path that leaves here in the same direction hits the light.
   const float light_pdf = light_density<Kinds>(scene, lm.emission, light.instance, light.prim, out.ray.origin,
                                                out.ray.dir, length);
-  const float w = power_heuristic(light_pdf, cos_s * (1.0f / kPi));
-  const vec3 f = material_albedo(m, scene.texture_array(), scene.image_array(), sp) * (1.0f / kPi);
+  const float w = power_heuristic(light_pdf, lobe * cos_s * (1.0f / kPi));
+  const vec3 f = material_albedo(m, scene.texture_array(), scene.image_array(), sp) * (lobe / kPi);
   out.contribution = throughput * f * lm.emission * (cos_s * w / (pick * s.pdf));
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
@@ -182,16 +188,25 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 facing_n = sp.front ? sp.n : -sp.n;
+  // The diffuse share of the surface's reflection (scatter_coated draws the coat's
+  // mirror with Schlick's probability from the front, and the base otherwise).
+  const float coat = m.kind == MaterialKind::Coated && sp.front
+                         ? schlick(fminf(-glm::dot(ray.dir, facing_n), 1.0f), 1.0f / m.ior)
+                         : 0.0f;
+  const float lobe = m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f);
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
-  if (kSampleLights && nee && m.kind == MaterialKind::Lambertian && static_cast<int>(bounce) + 1 < rp.depth) {
-    shadow = sample_light<Kinds>(scene, m, sp, facing_n, throughput, rng);
+  if (kSampleLights && nee && lobe > 0.0f && static_cast<int>(bounce) + 1 < rp.depth) {
+    shadow = sample_light<Kinds>(scene, m, sp, facing_n, lobe, throughput, rng);
   }
   vec3 attenuation;
   Ray next;
   if (!scatter(m, scene.texture_array(), scene.image_array(), ray, sp, rng, attenuation, next)) return false;
-  pdf = m.kind == MaterialKind::Lambertian ? fmaxf(glm::dot(next.dir, facing_n), 0.0f) * (1.0f / kPi) : 0.0f;
+  // The density of the direction the path goes on in, where the BSDF has one: the
+  // diffuse lobe's; 0 after a mirror-like bounce (the coat's, when it was drawn).
+  const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
+  pdf = lobe > 0.0f && !mirrored ? lobe * fmaxf(glm::dot(next.dir, facing_n), 0.0f) * (1.0f / kPi) : 0.0f;
   throughput *= attenuation;
   if (static_cast<int>(bounce) + 1 >= rp.roulette_depth) {
     // Survive with probability p and divide by it: the expectation is unchanged.
