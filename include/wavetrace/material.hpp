@@ -91,27 +91,34 @@ WT_HD WT_INLINE bool above_surface(const SurfacePoint& sp, const Ray& next) {
   return glm::dot(next.dir, sp.front ? sp.ng : -sp.ng) >= 0.0f;
 }
 
-// Scatters the path at a hit. Returns false when the path ends there (absorbed or emitter).
-WT_HD WT_INLINE bool scatter(const Material& m, const Texture* textures, const ImageView* images, const Ray& in,
-                             const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
+// Scatters the path at a hit, given the surface's albedo there (material_albedo:
+// the caller may need it twice, and a texture is worth evaluating once). Returns
+// false when the path ends there (absorbed or emitter).
+WT_HD WT_INLINE bool scatter_with_albedo(const Material& m, const vec3& albedo, const Ray& in,
+                                         const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
   vec3 facing_n = sp.front ? sp.n : -sp.n;
   switch (m.kind) {
     case MaterialKind::Lambertian:
-      scatter_lambertian(material_albedo(m, textures, images, sp), sp, facing_n, rng, attenuation, next);
+      scatter_lambertian(albedo, sp, facing_n, rng, attenuation, next);
       return above_surface(sp, next);
     case MaterialKind::Metal:
-      return scatter_metal(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next) &&
-             above_surface(sp, next);
+      return scatter_metal(m, albedo, in, sp, facing_n, rng, attenuation, next) && above_surface(sp, next);
     case MaterialKind::Dielectric:
-      scatter_dielectric(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+      scatter_dielectric(m, albedo, in, sp, facing_n, rng, attenuation, next);
       return true;
     case MaterialKind::Coated:
-      scatter_coated(m, material_albedo(m, textures, images, sp), in, sp, facing_n, rng, attenuation, next);
+      scatter_coated(m, albedo, in, sp, facing_n, rng, attenuation, next);
       return above_surface(sp, next);
     case MaterialKind::Emissive:
       return false;
   }
   return false;
+}
+
+WT_HD WT_INLINE bool scatter(const Material& m, const Texture* textures, const ImageView* images, const Ray& in,
+                             const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
+  if (m.kind == MaterialKind::Emissive) return false;
+  return scatter_with_albedo(m, material_albedo(m, textures, images, sp), in, sp, rng, attenuation, next);
 }
 
 }  // namespace wt

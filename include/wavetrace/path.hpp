@@ -124,7 +124,7 @@ constexpr float kShadowShorten = 1e-4f;
 // 1 - Fresnel for a coat over a diffuse base), which scales both the BSDF and the
 // density with which the BSDF samples the direction.
 template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, const SurfacePoint& sp,
+WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, const SurfacePoint& sp,
                                        const vec3& facing_n, float lobe, const vec3& throughput, const Rng& rng) {
   ShadowRay out{};
   out.valid = false;
@@ -157,7 +157,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const Material& m, co
   const float light_pdf = light_density<Kinds>(scene, lm.emission, light.instance, light.prim, out.ray.origin,
                                                out.ray.dir, length);
   const float w = power_heuristic(light_pdf, lobe * cos_s * (1.0f / kPi));
-  const vec3 f = material_albedo(m, scene.texture_array(), scene.image_array(), sp) * (lobe / kPi);
+  const vec3 f = albedo * (lobe / kPi);
   out.contribution = throughput * f * lm.emission * (cos_s * w / (pick * s.pdf));
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
@@ -197,12 +197,13 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
+  const vec3 albedo = material_albedo(m, scene.texture_array(), scene.image_array(), sp);
   if (kSampleLights && nee && lobe > 0.0f && static_cast<int>(bounce) + 1 < rp.depth) {
-    shadow = sample_light<Kinds>(scene, m, sp, facing_n, lobe, throughput, rng);
+    shadow = sample_light<Kinds>(scene, albedo, sp, facing_n, lobe, throughput, rng);
   }
   vec3 attenuation;
   Ray next;
-  if (!scatter(m, scene.texture_array(), scene.image_array(), ray, sp, rng, attenuation, next)) return false;
+  if (!scatter_with_albedo(m, albedo, ray, sp, rng, attenuation, next)) return false;
   // The density of the direction the path goes on in, where the BSDF has one: the
   // diffuse lobe's; 0 after a mirror-like bounce (the coat's, when it was drawn).
   const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
