@@ -7,6 +7,8 @@
 #include <stb/stb_image_write.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -186,6 +188,28 @@ TEST(Environment, RadianceHdrLoadsAsLinearRadiance) {
     EXPECT_NEAR(im.texels[4 * i + 1], 100.0f, 100.0f / 128.0f) << i;
     EXPECT_EQ(im.texels[4 * i + 3], 1.0f);
   }
+}
+
+// A truncated Radiance file (its run-length data cut short) is refused with one
+// line naming it, and does not hang the reader (stb's decoder alone loops forever
+// at the end of such a file).
+TEST(Environment, TruncatedRadianceHdrIsRefused) {
+  test::TestFolder folder;
+  std::ifstream in(test::repo_path("scenes/textures/sky_sun.hdr"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  for (size_t keep : {size_t(200), bytes.size() / 2, bytes.size() - 1}) {
+    std::ofstream(folder.root() / "cut.hdr", std::ios::binary) << bytes.substr(0, keep);
+    const std::string e = error_of(sky_scene(R"({"type": "environment", "file": "cut.hdr"})"),
+                                   (folder.root() / "scene.json").string());
+    EXPECT_NE(e.find("/sky/file: cannot read image"), std::string::npos) << keep << ": " << e;
+    EXPECT_NE(e.find("cut.hdr"), std::string::npos) << e;
+  }
+  // The whole file still loads.
+  std::ofstream(folder.root() / "whole.hdr", std::ios::binary) << bytes;
+  const Scene s = parse_scene(sky_scene(R"({"type": "environment", "file": "whole.hdr"})"),
+                              (folder.root() / "scene.json").string());
+  EXPECT_EQ(s.images.at(s.sky.image).width, 512);
 }
 
 TEST(Environment, OpenExrLoadsAndBadValuesAreRefusedNamingTheTexel) {

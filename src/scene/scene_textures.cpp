@@ -4,9 +4,14 @@
 #include <ImfRgbaFile.h>
 #include <stb/stb_image.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <exception>
+#include <fstream>
+#include <iterator>
 #include <utility>
 
 #include "scene/scene_reader.hpp"
@@ -72,12 +77,60 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+// The bytes of a file for stb, and once the decoder has taken them all and asks for
+// more, a supply of 0xff that never runs out, noting that it was drawn on. stb's
+// Radiance decoder reads a run-length count of 0 at the end of a truncated file
+// (its reads return 0 there) and loops without end; a count of 0xff always makes
+// progress or an error, so the decoder ends, and a decode that asked for bytes past
+// the file is reported as truncated. (stb asks again only for a byte it needs: a
+// short read ends its buffer where the file ends.)
+struct PaddedBytes {
+  std::string bytes;
+  size_t at = 0;
+  bool overran = false;
+
+  static int read(void* user, char* data, int size) {
+    auto& p = *static_cast<PaddedBytes*>(user);
+    if (size <= 0) return 0;
+    if (p.at < p.bytes.size()) {
+      const size_t n = std::min(static_cast<size_t>(size), p.bytes.size() - p.at);
+      std::memcpy(data, p.bytes.data() + p.at, n);
+      p.at += n;
+      return static_cast<int>(n);
+    }
+    std::memset(data, 0xff, static_cast<size_t>(size));
+    p.overran = true;
+    return size;
+  }
+  static void skip(void* user, int n) {
+    auto& p = *static_cast<PaddedBytes*>(user);
+    const int64_t to = static_cast<int64_t>(p.at) + n;
+    p.at = to < 0 ? 0 : static_cast<size_t>(to);
+  }
+  static int eof(void*) { return 0; }
+};
+
 // A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
 bool read_hdr(const std::string& path, Image& im, std::string& why) {
+  PaddedBytes file;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+      why = std::string("cannot open it (") + std::strerror(errno) + ")";
+      return false;
+    }
+    file.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) {
+      why = "cannot read it";
+      return false;
+    }
+  }
+  const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
   int w = 0, h = 0, channels = 0;
-  float* data = stbi_loadf(path.c_str(), &w, &h, &channels, 0);
-  if (!data) {
-    why = stbi_failure_reason();
+  float* data = stbi_loadf_from_callbacks(&callbacks, &file, &w, &h, &channels, 0);
+  if (!data || file.overran) {
+    why = data ? "the file ends before its pixels do" : stbi_failure_reason();
+    stbi_image_free(data);
     return false;
   }
   im.width = w;
@@ -97,11 +150,19 @@ bool read_exr(const std::string& path, Image& im, std::string& why) {
   try {
     Imf::RgbaInputFile file(path.c_str());
     const Imath::Box2i window = file.dataWindow();
-    const int w = window.max.x - window.min.x + 1, h = window.max.y - window.min.y + 1;
-    if (w <= 0 || h <= 0) {
+    const int64_t w64 = int64_t{window.max.x} - window.min.x + 1, h64 = int64_t{window.max.y} - window.min.y + 1;
+    if (w64 <= 0 || h64 <= 0) {
       why = "the image is empty";
       return false;
     }
+    // The texels are indexed with 32-bit sizes on the device, and a header of a few
+    // bytes can claim any size: refuse more than 2^31 texels before allocating.
+    if (w64 * h64 > (int64_t{1} << 31)) {
+      why = "the image claims " + std::to_string(w64) + " x " + std::to_string(h64) +
+            " texels, more than 2^31";
+      return false;
+    }
+    const int w = static_cast<int>(w64), h = static_cast<int>(h64);
     Imf::Array2D<Imf::Rgba> pixels(h, w);
     file.setFrameBuffer(&pixels[0][0] - window.min.x - static_cast<ptrdiff_t>(window.min.y) * w, 1, w);
     file.readPixels(window.min.y, window.max.y);
