@@ -204,6 +204,14 @@ TEST(Environment, TruncatedRadianceHdrIsRefused) {
                                    (folder.root() / "scene.json").string());
     EXPECT_NE(e.find("/sky/file: cannot read image"), std::string::npos) << keep << ": " << e;
     EXPECT_NE(e.find("cut.hdr"), std::string::npos) << e;
+    // The same bytes under another name, as an image texture (stb reads by content).
+    std::ofstream(folder.root() / "cut.png", std::ios::binary) << bytes.substr(0, keep);
+    const std::string t = error_of(R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]},
+        "textures": [{"name": "t", "type": "image", "file": "cut.png"}],
+        "materials": [{"name": "m", "type": "lambertian", "albedo": [1, 1, 1], "texture": "t"}],
+        "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})",
+                                   (folder.root() / "scene.json").string());
+    EXPECT_NE(t.find("/textures/0/file: cannot read image"), std::string::npos) << keep << ": " << t;
   }
   // The whole file still loads.
   std::ofstream(folder.root() / "whole.hdr", std::ios::binary) << bytes;

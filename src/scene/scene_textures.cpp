@@ -78,12 +78,13 @@ std::string lower_extension(const std::string& path) {
 }
 
 // The bytes of a file for stb, and once the decoder has taken them all and asks for
-// more, a supply of 0xff that never runs out, noting that it was drawn on. stb's
-// Radiance decoder reads a run-length count of 0 at the end of a truncated file
-// (its reads return 0 there) and loops without end; a count of 0xff always makes
-// progress or an error, so the decoder ends, and a decode that asked for bytes past
-// the file is reported as truncated. (stb asks again only for a byte it needs: a
-// short read ends its buffer where the file ends.)
+// more, a supply of newlines that never runs out, noting that it was drawn on.
+// stb's Radiance decoder reads a run-length count of 0 at the end of a truncated
+// file (its reads return 0 there) and loops without end. A newline ends the
+// header's lines (an empty line ends the header), and as a run-length count (10)
+// it always makes progress or an error, so the decoder ends; a decode that asked
+// for bytes past the file is reported as truncated. (stb asks again only for a
+// byte it needs: a short read ends its buffer where the file ends.)
 struct PaddedBytes {
   std::string bytes;
   size_t at = 0;
@@ -98,7 +99,7 @@ struct PaddedBytes {
       p.at += n;
       return static_cast<int>(n);
     }
-    std::memset(data, 0xff, static_cast<size_t>(size));
+    std::memset(data, '\n', static_cast<size_t>(size));
     p.overran = true;
     return size;
   }
@@ -108,23 +109,27 @@ struct PaddedBytes {
     p.at = to < 0 ? 0 : static_cast<size_t>(to);
   }
   static int eof(void*) { return 0; }
-};
 
-// A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
-bool read_hdr(const std::string& path, Image& im, std::string& why) {
-  PaddedBytes file;
-  {
+  // Reads the whole file; false with the reason.
+  bool load(const std::string& path, std::string& why) {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
       why = std::string("cannot open it (") + std::strerror(errno) + ")";
       return false;
     }
-    file.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     if (in.bad()) {
       why = "cannot read it";
       return false;
     }
+    return true;
   }
+};
+
+// A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
+bool read_hdr(const std::string& path, Image& im, std::string& why) {
+  PaddedBytes file;
+  if (!file.load(path, why)) return false;
   const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
   int w = 0, h = 0, channels = 0;
   float* data = stbi_loadf_from_callbacks(&callbacks, &file, &w, &h, &channels, 0);
@@ -226,9 +231,24 @@ int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::strin
   // Read in the file's own channels and widened to RGBA here: stb 2.27 (Debian
   // bookworm) reads past its buffer when it converts a 16-bit PNM to 4 channels.
   int w = 0, h = 0, channels = 0;
-  stbi_uc* data = stbi_load(resolved.c_str(), &w, &h, &channels, 0);
+  stbi_uc* data = nullptr;
+  if (stbi_is_hdr(resolved.c_str())) {
+    // Radiance data under another name: through the padding that keeps stb's
+    // decoder from looping at a truncated end (read_hdr), as 8 bits.
+    PaddedBytes file;
+    if (!file.load(resolved, why)) return -1;
+    const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
+    data = stbi_load_from_callbacks(&callbacks, &file, &w, &h, &channels, 0);
+    if (data && file.overran) {
+      stbi_image_free(data);
+      why = "the file ends before its pixels do";
+      return -1;
+    }
+  } else {
+    data = stbi_load(resolved.c_str(), &w, &h, &channels, 0);
+  }
   if (!data) {
-    why = stbi_failure_reason();
+    if (why.empty()) why = stbi_failure_reason();
     return -1;
   }
   Image im;
