@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Tables of the mesh benchmark: counted rays per second per scene and kernel, over
 whole paths (depth 16) and primary rays alone (depth 1), with each scene's
-geometry (triangles stored and placed, BVH build time and SAH cost).
+geometry (triangles stored and placed, BVH build time and SAH cost), and for the
+scenes with emitters the shadow rays of light sampling, counted apart.
 
     python3 bench/mesh_tables.py RESULTS.json [RESULTS.json ...] > tables.md
 """
@@ -49,6 +50,23 @@ def main():
                     cells.append("refused" if "constant memory" in r["status"] else r["status"][:30])
                 else:
                     cells.append("%.0f" % r["m_rays_per_s"])
+            print("| %s | %s |" % (s, " | ".join(cells)))
+        print()
+    # Light sampling's shadow rays (not in the counts above), where a scene has them.
+    lit = [s for s in scenes if any(r["group"] == s and r.get("shadow_rays", 0) > 0 for r in rows)]
+    if lit:
+        print("Light sampling, whole paths: M shadow rays/s (apart from the path rays above), and shadow rays per path ray:")
+        print()
+        print("| scene | " + " | ".join(kernels) + " |")
+        print("| --- |" + " ---: |" * len(kernels))
+        for s in lit:
+            cells = []
+            for k in kernels:
+                r = next((r for r in rows if r["group"] == s and r["kernel"] == k and r["depth"] > 1), None)
+                if r is None or r["status"] != "ok":
+                    cells.append("-")
+                else:
+                    cells.append("%.0f (%.2f)" % (r.get("m_shadow_rays_per_s", 0.0), r.get("shadow_rays", 0) / r["rays"]))
             print("| %s | %s |" % (s, " | ".join(cells)))
         print()
 
