@@ -126,18 +126,33 @@ struct PaddedBytes {
   }
 };
 
+// Decodes `path` with one of stb's callback loaders (stbi_loadf_from_callbacks,
+// stbi_load_from_callbacks) over PaddedBytes, in the file's own channels. Null with
+// the reason when stb refuses the file or asked for bytes past its end.
+template <class Texel>
+Texel* decode_padded(const std::string& path, Texel* (*load)(const stbi_io_callbacks*, void*, int*, int*, int*, int),
+                     int& w, int& h, int& channels, std::string& why) {
+  PaddedBytes file;
+  if (!file.load(path, why)) return nullptr;
+  const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
+  Texel* data = load(&callbacks, &file, &w, &h, &channels, 0);
+  if (!data) {
+    why = stbi_failure_reason();
+    return nullptr;
+  }
+  if (file.overran) {
+    stbi_image_free(data);
+    why = "the file ends before its pixels do";
+    return nullptr;
+  }
+  return data;
+}
+
 // A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
 bool read_hdr(const std::string& path, Image& im, std::string& why) {
-  PaddedBytes file;
-  if (!file.load(path, why)) return false;
-  const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
   int w = 0, h = 0, channels = 0;
-  float* data = stbi_loadf_from_callbacks(&callbacks, &file, &w, &h, &channels, 0);
-  if (!data || file.overran) {
-    why = data ? "the file ends before its pixels do" : stbi_failure_reason();
-    stbi_image_free(data);
-    return false;
-  }
+  float* data = decode_padded(path, &stbi_loadf_from_callbacks, w, h, channels, why);
+  if (!data) return false;
   im.width = w;
   im.height = h;
   im.texels.resize(static_cast<size_t>(w) * h * 4);
@@ -145,6 +160,34 @@ bool read_hdr(const std::string& path, Image& im, std::string& why) {
     const float* texel = data + p * channels;
     for (int c = 0; c < 3; ++c) im.texels[4 * p + c] = texel[channels >= 3 ? c : 0];
     im.texels[4 * p + 3] = 1.0f;
+  }
+  stbi_image_free(data);
+  return true;
+}
+
+// An 8-bit image through stb, in the file's own channels widened to RGBA here
+// (stb 2.27, Debian bookworm, reads past its buffer when it converts a 16-bit PNM
+// to 4 channels), decoded from sRGB where `srgb` says. Radiance data under another
+// name (stb reads by content) goes through the padding read_hdr uses. False with
+// the reason.
+bool read_8bit(const std::string& path, bool srgb, Image& im, std::string& why) {
+  int w = 0, h = 0, channels = 0;
+  stbi_uc* data = stbi_is_hdr(path.c_str()) ? decode_padded(path, &stbi_load_from_callbacks, w, h, channels, why)
+                                            : stbi_load(path.c_str(), &w, &h, &channels, 0);
+  if (!data) {
+    if (why.empty()) why = stbi_failure_reason();
+    return false;
+  }
+  im.width = w;
+  im.height = h;
+  im.texels.resize(static_cast<size_t>(w) * h * 4);
+  for (size_t i = 0; i < im.texels.size(); ++i) {
+    const stbi_uc* texel = data + i / 4 * channels;
+    bool alpha = i % 4 == 3;
+    // grey: g g g 1; grey + alpha: g g g a; RGB: r g b 1; RGBA.
+    float v = alpha ? (channels % 2 == 0 ? texel[channels - 1] / 255.0f : 1.0f)
+                    : texel[channels >= 3 ? i % 4 : 0] / 255.0f;
+    im.texels[i] = srgb && !alpha ? decode_srgb(v) : v;
   }
   stbi_image_free(data);
   return true;
@@ -214,57 +257,14 @@ int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::strin
   if (known != images_.end()) return known->second;
 
   const auto start = Clock::now();
-  // Radiance .hdr and OpenEXR files hold linear values, whatever the colorspace says.
-  const std::string ext = lower_extension(resolved);
-  if (ext == ".hdr" || ext == ".exr") {
-    Image im;
-    im.path = resolved;
-    if (!(ext == ".hdr" ? read_hdr(resolved, im, why) : read_exr(resolved, im, why)) || !check_radiance(im, why)) {
-      return -1;
-    }
-    texture_seconds_ += seconds_since(start);
-    const int32_t index = static_cast<int32_t>(scene_.images.size());
-    scene_.images.push_back(std::move(im));
-    images_.emplace(std::make_pair(resolved, srgb), index);
-    return index;
-  }
-  // Read in the file's own channels and widened to RGBA here: stb 2.27 (Debian
-  // bookworm) reads past its buffer when it converts a 16-bit PNM to 4 channels.
-  int w = 0, h = 0, channels = 0;
-  stbi_uc* data = nullptr;
-  if (stbi_is_hdr(resolved.c_str())) {
-    // Radiance data under another name: through the padding that keeps stb's
-    // decoder from looping at a truncated end (read_hdr), as 8 bits.
-    PaddedBytes file;
-    if (!file.load(resolved, why)) return -1;
-    const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
-    data = stbi_load_from_callbacks(&callbacks, &file, &w, &h, &channels, 0);
-    if (data && file.overran) {
-      stbi_image_free(data);
-      why = "the file ends before its pixels do";
-      return -1;
-    }
-  } else {
-    data = stbi_load(resolved.c_str(), &w, &h, &channels, 0);
-  }
-  if (!data) {
-    if (why.empty()) why = stbi_failure_reason();
-    return -1;
-  }
   Image im;
   im.path = resolved;
-  im.width = w;
-  im.height = h;
-  im.texels.resize(static_cast<size_t>(w) * h * 4);
-  for (size_t i = 0; i < im.texels.size(); ++i) {
-    const stbi_uc* texel = data + i / 4 * channels;
-    bool alpha = i % 4 == 3;
-    // grey: g g g 1; grey + alpha: g g g a; RGB: r g b 1; RGBA.
-    float v = alpha ? (channels % 2 == 0 ? texel[channels - 1] / 255.0f : 1.0f)
-                    : texel[channels >= 3 ? i % 4 : 0] / 255.0f;
-    im.texels[i] = srgb && !alpha ? decode_srgb(v) : v;
-  }
-  stbi_image_free(data);
+  // Radiance .hdr and OpenEXR files hold linear values, whatever the colorspace says.
+  const std::string ext = lower_extension(resolved);
+  const bool read = ext == ".hdr"   ? read_hdr(resolved, im, why) && check_radiance(im, why)
+                    : ext == ".exr" ? read_exr(resolved, im, why) && check_radiance(im, why)
+                                    : read_8bit(resolved, srgb, im, why);
+  if (!read) return -1;
   texture_seconds_ += seconds_since(start);
 
   int32_t index = static_cast<int32_t>(scene_.images.size());
