@@ -38,37 +38,33 @@ def main():
     for label, depth in (("whole paths (depth 16)", lambda d: d > 1), ("primary rays (depth 1)", lambda d: d == 1)):
         print("M counted rays/s, %s, 1920x1080, 64 spp, median of 3:" % label)
         print()
-        print("| scene | " + " | ".join(kernels) + " |")
-        print("| --- |" + " ---: |" * len(kernels))
-        for s in scenes:
-            cells = []
-            for k in kernels:
-                r = next((r for r in rows if r["group"] == s and r["kernel"] == k and depth(r["depth"])), None)
-                if r is None:
-                    cells.append("-")
-                elif r["status"] != "ok":
-                    cells.append("refused" if "constant memory" in r["status"] else r["status"][:30])
-                else:
-                    cells.append("%.0f" % r["m_rays_per_s"])
-            print("| %s | %s |" % (s, " | ".join(cells)))
-        print()
+        table(rows, scenes, kernels, depth, lambda r: "%.0f" % r["m_rays_per_s"])
     # Light sampling's shadow rays (not in the counts above), where a scene has them.
     lit = [s for s in scenes if any(r["group"] == s and r.get("shadow_rays", 0) > 0 for r in rows)]
     if lit:
         print("Light sampling, whole paths: M shadow rays/s (apart from the path rays above), and shadow rays per path ray:")
         print()
-        print("| scene | " + " | ".join(kernels) + " |")
-        print("| --- |" + " ---: |" * len(kernels))
-        for s in lit:
-            cells = []
-            for k in kernels:
-                r = next((r for r in rows if r["group"] == s and r["kernel"] == k and r["depth"] > 1), None)
-                if r is None or r["status"] != "ok":
-                    cells.append("-")
-                else:
-                    cells.append("%.0f (%.2f)" % (r.get("m_shadow_rays_per_s", 0.0), r.get("shadow_rays", 0) / r["rays"]))
-            print("| %s | %s |" % (s, " | ".join(cells)))
-        print()
+        table(rows, lit, kernels, lambda d: d > 1,
+              lambda r: "%.0f (%.2f)" % (r.get("m_shadow_rays_per_s", 0.0), r.get("shadow_rays", 0) / r["rays"]))
+
+
+def table(rows, scenes, kernels, depth, value):
+    """One row per scene, one column per kernel: value(row) of the point at a depth
+    depth() accepts; "-" where there is none, the reason where it did not run."""
+    print("| scene | " + " | ".join(kernels) + " |")
+    print("| --- |" + " ---: |" * len(kernels))
+    for s in scenes:
+        cells = []
+        for k in kernels:
+            r = next((r for r in rows if r["group"] == s and r["kernel"] == k and depth(r["depth"])), None)
+            if r is None:
+                cells.append("-")
+            elif r["status"] != "ok":
+                cells.append("refused" if "constant memory" in r["status"] else r["status"][:30])
+            else:
+                cells.append(value(r))
+        print("| %s | %s |" % (s, " | ".join(cells)))
+    print()
 
 
 if __name__ == "__main__":
