@@ -14,7 +14,7 @@
 #include <limits>
 #include <vector>
 
-#include "scene/environment_distribution.hpp"
+#include "scene/scene.hpp"
 #include "wavetrace/rng.hpp"
 #include "wavetrace/sampling.hpp"
 

@@ -13,6 +13,7 @@
 // density the sampler draws from, and no cell has density 0.
 #pragma once
 
+#include "wavetrace/sampling.hpp"
 #include "wavetrace/sky.hpp"
 
 namespace wt {
@@ -106,11 +107,11 @@ struct PiecewiseConstant2D {
 // ---------------------------------------------------------------------------------
 // The environment sky's directions.
 //
-// Only EnvironmentMapping::LatLong is importance-sampled. The angular map and the
-// mirror ball are not yet: their tables would need the Jacobian of those mappings
-// (and the mirror ball's corners lie outside the disc). For them, and for an empty
-// table, sample_environment returns pdf 0 (no sample) and environment_pdf returns 0,
-// so BSDF sampling alone covers them (its MIS weight is then 1).
+// Only EnvironmentMapping::LatLong has a table. The angular map and the mirror ball
+// would need the Jacobian of those mappings (and the mirror ball's corners lie
+// outside the disc); light sampling draws their directions uniformly over the
+// sphere instead (sample_sky_direction below). For them, and for an empty table,
+// sample_environment returns pdf 0 (no sample) and environment_pdf returns 0.
 //
 // A LatLong image of W x H texels covers (u, v) in [0, 1)^2, texel (x, y) the cell
 // [x/W, (x+1)/W) x [y/H, (y+1)/H) (texel centres at half-integers, as sample_image
@@ -169,6 +170,31 @@ WT_HD WT_INLINE float environment_pdf(const Sky& sky, const PiecewiseConstant2D&
   if (sin_theta == 0.0f) return 0.0f;
   // environment_uv's u is in (-1/2, 1/2]: wrapped as sample_image wraps it.
   return table.pdf(uv.x - floorf(uv.x), uv.y) / (2.0f * kPi * kPi * sin_theta);
+}
+
+// ---------------------------------------------------------------------------------
+// The sky as a light. Where the scene samples its sky (SceneView::sky_light_pick() >
+// 0: src/scene/scene_bvh.cpp says which skies), light sampling draws directions from
+// the environment's table where it has one (a LatLong environment), and uniformly
+// over the sphere otherwise (a uniform sky, and the angular and mirror-ball maps,
+// which have no table). sky_direction_pdf is the density of both for MIS.
+
+struct SkyDirection {
+  vec3 dir;   // world space, unit up to rounding
+  float pdf;  // per solid angle; 0: no sample
+};
+
+WT_HD WT_INLINE SkyDirection sample_sky_direction(const Sky& sky, const PiecewiseConstant2D& table, float u1,
+                                                  float u2) {
+  if (table.rows > 0) {
+    const EnvironmentSample s = sample_environment(sky, table, u1, u2);
+    return SkyDirection{s.direction, s.pdf};
+  }
+  return SkyDirection{unit_sphere_point(u1, u2), 1.0f / (4.0f * kPi)};
+}
+
+WT_HD WT_INLINE float sky_direction_pdf(const Sky& sky, const PiecewiseConstant2D& table, const vec3& unit_dir) {
+  return table.rows > 0 ? environment_pdf(sky, table, unit_dir) : 1.0f / (4.0f * kPi);
 }
 
 }  // namespace wt

@@ -11,9 +11,12 @@ namespace wt {
 // An emitter: a primitive of an instance whose material emits (an emissive sphere,
 // or one triangle of a placed mesh).
 struct LightRef {
-  int32_t instance;
+  int32_t instance;  // kSkyLight: the sky
   int32_t prim;
 };
+
+// The instance of the LightRef that stands for the sky, when the sky is sampled.
+constexpr int32_t kSkyLight = -1;
 
 // The power that picks an emitter among the scene's: its emission's mean over the
 // three channels times its area (the factor pi of a diffuse emitter's power is the
@@ -107,6 +110,36 @@ WT_HD WT_INLINE LightSample sample_triangle_light(const vec3& a, const vec3& b, 
   s.pdf = triangle_light_pdf(a, b, c, s.dir, dist);
   return s;
 }
+
+// An emitter's shape in world space, read from the scene once per use (path.hpp's
+// emitter_shape): a sphere (centre `a`, `radius`) or a triangle (corners a, b, c).
+// Its area weighs it in the picking table (light_power_of), its sampler draws
+// points on it and its density says how likely a direction is, so the host's table
+// and the shading code compute them with the same float arithmetic.
+struct EmitterShape {
+  vec3 a, b, c;
+  float radius;  // > 0: a sphere; 0: a triangle
+  bool sphere;
+
+  WT_HD static EmitterShape of_sphere(const vec3& centre, float r) {
+    return EmitterShape{centre, vec3(0.0f), vec3(0.0f), r, true};
+  }
+  WT_HD static EmitterShape of_triangle(const vec3& a, const vec3& b, const vec3& c) {
+    return EmitterShape{a, b, c, 0.0f, false};
+  }
+
+  WT_HD float area() const {
+    return sphere ? 4.0f * kPi * radius * radius : 0.5f * glm::length(glm::cross(b - a, c - a));
+  }
+  // The density per solid angle at p of sample(p, ...) drawing `dir` (unit), which
+  // meets the shape at distance `dist`.
+  WT_HD float pdf(const vec3& p, const vec3& dir, float dist) const {
+    return sphere ? sphere_light_pdf(a, radius, p) : triangle_light_pdf(a, b, c, dir, dist);
+  }
+  WT_HD LightSample sample(const vec3& p, float u1, float u2) const {
+    return sphere ? sample_sphere_light(a, radius, p, u1, u2) : sample_triangle_light(a, b, c, p, u1, u2);
+  }
+};
 
 // The power heuristic (exponent 2): the weight of a sample drawn by the strategy of
 // density f where another strategy would have drawn it with density g. The two

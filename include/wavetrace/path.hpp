@@ -34,9 +34,7 @@ WT_HD WT_INLINE bool occluded(const Scene& scene, const Ray& ray, float tmax) {
 }
 
 // A triangle of an instance, in world space.
-template <class Scene>
-WT_HD WT_INLINE void world_triangle(const Scene& scene, const Instance& in, int prim, vec3& a, vec3& b, vec3& c) {
-  const TriangleGeom t = scene.triangle(prim);
+WT_HD WT_INLINE void world_triangle(const TriangleGeom& t, const Instance& in, vec3& a, vec3& b, vec3& c) {
   a = t.corner(0);
   b = t.corner(1);
   c = t.corner(2);
@@ -47,40 +45,46 @@ WT_HD WT_INLINE void world_triangle(const Scene& scene, const Instance& in, int 
   }
 }
 
-// The probability of picking emitter (instance, prim) among the scene's, by power
-// (light_power_of), from its emission and its world-space shape.
+// Emitter (instance, prim)'s shape in world space (spheres are placed untransformed).
 template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE float light_pick_probability(const Scene& scene, const vec3& emission, int instance, int prim) {
-  float area;
+WT_HD WT_INLINE EmitterShape emitter_shape(const Scene& scene, int instance, int prim) {
   if (spheres_only(Kinds) || scene.instance(instance).kind == PrimitiveKind::Sphere) {
     const SphereGeom sg = scene.sphere(prim);
-    area = 4.0f * kPi * sg.w * sg.w;
-  } else {
-    vec3 a, b, c;
-    world_triangle(scene, scene.instance(instance), prim, a, b, c);
-    area = 0.5f * glm::length(glm::cross(b - a, c - a));
+    return EmitterShape::of_sphere(vec3(sg.x, sg.y, sg.z), sg.w);
   }
-  return light_power_of(emission, area) / scene.total_light_power();
+  vec3 a, b, c;
+  world_triangle(scene.triangle(prim), scene.instance(instance), a, b, c);
+  return EmitterShape::of_triangle(a, b, c);
 }
 
 // The density per solid angle with which light sampling from `from` draws the
-// direction `dir` (unit) that meets emitter (instance, prim) at distance `dist`:
-// the picking probability times the emitter's own density. Evaluated the same way
-// for a light sample and for a path that hits the emitter, so that the two MIS
-// weights of a direction sum to one.
-template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE float light_density(const Scene& scene, const vec3& emission, int instance, int prim,
+// direction `dir` (unit) that meets the emitter of this emission and shape at
+// distance `dist`: the probability of picking it by power (the host's table holds
+// the same light_power_of) times the shape's own density. Evaluated the same way for
+// a light sample and for a path that hits the emitter, so that the two MIS weights
+// of a direction sum to one.
+template <class Scene>
+WT_HD WT_INLINE float light_density(const Scene& scene, const vec3& emission, const EmitterShape& shape,
                                     const vec3& from, const vec3& dir, float dist) {
-  float pdf;
-  if (spheres_only(Kinds) || scene.instance(instance).kind == PrimitiveKind::Sphere) {
-    const SphereGeom sg = scene.sphere(prim);
-    pdf = sphere_light_pdf(vec3(sg.x, sg.y, sg.z), sg.w, from);
-  } else {
-    vec3 a, b, c;
-    world_triangle(scene, scene.instance(instance), prim, a, b, c);
-    pdf = triangle_light_pdf(a, b, c, dir, dist);
-  }
-  return pdf > 0.0f ? light_pick_probability<Kinds>(scene, emission, instance, prim) * pdf : 0.0f;
+  const float pdf = shape.pdf(from, dir, dist);
+  return pdf > 0.0f ? light_power_of(emission, shape.area()) / scene.total_light_power() * pdf : 0.0f;
+}
+
+// The same for the sky (when it is sampled) and the direction `dir`.
+template <class Scene>
+WT_HD WT_INLINE float sky_light_density(const Scene& scene, const vec3& dir) {
+  return scene.sky_light_pick() * sky_direction_pdf(scene.sky, scene.environment_table(), dir);
+}
+
+// What a path adds that leaves the scene along `dir` (unit): the sky's radiance,
+// weighted against light sampling where the sky is a sampled light and the path's
+// last bounce (of BSDF density `pdf`; 0 after a specular bounce or the camera)
+// sampled the lights.
+template <class Scene>
+WT_HD WT_INLINE vec3 sky_seen(const Scene& scene, const RenderParams& rp, const vec3& dir, float pdf) {
+  const vec3 sky = scene.sky.radiance(dir, scene.image_array());
+  if (rp.nee == 0 || !(pdf > 0.0f) || !(scene.sky_light_pick() > 0.0f)) return sky;
+  return sky * power_heuristic(pdf, sky_light_density(scene, dir));
 }
 
 // The emitter that u (in [0, 1)) picks from the scene's table, and the probability
@@ -113,52 +117,70 @@ struct ShadowRay {
 // count the emitter's own surface as what blocks them.
 constexpr float kShadowShorten = 1e-4f;
 
-// Next-event estimation at a diffuse hit: one emitter picked by power, one point on
-// it, and its contribution weighted against the BSDF's sampling of the same
-// direction (the power heuristic). Lambertian surfaces and the diffuse base of
-// coated ones are light-sampled; specular and glossy ones (dielectric, metal, a
-// coat's mirror reflection) are not, and the paths they scatter count what they
-// hit in full.
-//
-// `lobe`: the share of the surface's reflection that is diffuse (1 for Lambertian;
-// 1 - Fresnel for a coat over a diffuse base), which scales both the BSDF and the
-// density with which the BSDF samples the direction.
+// What light sampling needs of the surface at a hit: the density with which its
+// BSDF samples a direction. For every surface light-sampled here, the BSDF times
+// the cosine is the albedo times that density (a Lambertian lobe's cos / pi, scaled
+// by its share `diffuse` of the reflection), so one function serves both.
+struct ScatterDensity {
+  vec3 facing_n;
+  float diffuse;  // the diffuse share: 1 for Lambertian; 1 - Fresnel for a coat's base; 0: none
+
+  WT_HD float operator()(const vec3& dir) const {
+    return diffuse * fmaxf(glm::dot(dir, facing_n), 0.0f) * (1.0f / kPi);
+  }
+  WT_HD bool samples_lights() const { return diffuse > 0.0f; }
+};
+
+// Next-event estimation at a hit: one light picked by power (an emitter, or the
+// sky), one point or direction on it, and its contribution weighted against the
+// BSDF's sampling of the same direction (the power heuristic). Lambertian surfaces
+// and the diffuse base of coated ones are light-sampled; specular ones (dielectric,
+// mirror metal, a coat's mirror reflection) are not, and the paths they scatter
+// count what they hit in full.
 template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, const SurfacePoint& sp,
-                                       const vec3& facing_n, float lobe, const vec3& throughput, const Rng& rng) {
+                                       const ScatterDensity& bsdf, const vec3& throughput, const Rng& rng) {
   ShadowRay out{};
   out.valid = false;
   float pick;
   const LightRef light = scene.light(pick_light(scene, rng.uniform(kDimLightPick), pick));
   if (!(pick > 0.0f)) return out;
-  LightSample s;
-  if (spheres_only(Kinds) || scene.instance(light.instance).kind == PrimitiveKind::Sphere) {
-    const SphereGeom sg = scene.sphere(light.prim);
-    s = sample_sphere_light(vec3(sg.x, sg.y, sg.z), sg.w, sp.p, rng.uniform(kDimLightA), rng.uniform(kDimLightB));
+  const float u1 = rng.uniform(kDimLightA), u2 = rng.uniform(kDimLightB);
+  const vec3 outward = sp.front ? sp.ng : -sp.ng;
+  vec3 emitted;
+  float drawn_pdf;  // the density the direction was drawn with, times the picking probability
+  float light_pdf;  // light_density's (or sky_light_density's) for it, for the MIS weight
+  if (light.instance == kSkyLight) {
+    const SkyDirection d = sample_sky_direction(scene.sky, scene.environment_table(), u1, u2);
+    if (!(d.pdf > 0.0f) || glm::dot(d.dir, outward) <= 0.0f) return out;
+    out.ray = spawn_ray(sp, d.dir);
+    out.tmax = kRayTMax;
+    emitted = scene.sky.radiance(d.dir, scene.image_array());
+    drawn_pdf = light_pdf = pick * d.pdf;
   } else {
-    vec3 a, b, c;
-    world_triangle(scene, scene.instance(light.instance), light.prim, a, b, c);
-    s = sample_triangle_light(a, b, c, sp.p, rng.uniform(kDimLightA), rng.uniform(kDimLightB));
+    const EmitterShape shape = emitter_shape<Kinds>(scene, light.instance, light.prim);
+    const LightSample s = shape.sample(sp.p, u1, u2);
+    if (!(s.pdf > 0.0f) || glm::dot(s.dir, outward) <= 0.0f) return out;
+    emitted = scene.material(material_index<Kinds>(scene, Hit{s.dist, light.instance, light.prim, 0.0f, 0.0f}))
+                  .emission;
+    // The shadow ray leaves from the offset a ray leaving the surface starts at, and
+    // is aimed at the sampled point itself, so that it ends on the light's surface
+    // (shortened by kShadowShorten) however large the offset is.
+    out.ray = spawn_ray(sp, s.dir);
+    const vec3 to = sp.p + s.dist * s.dir - out.ray.origin;
+    const float length = sqrtf(glm::dot(to, to));
+    if (!(length > 0.0f)) return out;
+    out.ray.dir = to * (1.0f / length);
+    out.tmax = length * (1.0f - kShadowShorten);
+    // The density light_density gives when a path that leaves here in the same
+    // direction hits the light, for the MIS weight.
+    drawn_pdf = pick * s.pdf;
+    light_pdf = light_density(scene, emitted, shape, out.ray.origin, out.ray.dir, length);
   }
-  const float cos_s = glm::dot(s.dir, facing_n);
-  if (!(s.pdf > 0.0f) || cos_s <= 0.0f || glm::dot(s.dir, sp.front ? sp.ng : -sp.ng) <= 0.0f) return out;
-  const Material& lm = scene.material(material_index<Kinds>(scene, Hit{s.dist, light.instance, light.prim, 0.0f, 0.0f}));
-  // The shadow ray leaves from the offset a ray leaving the surface starts at, and
-  // is aimed at the sampled point itself, so that it ends on the light's surface
-  // (shortened by kShadowShorten) however large the offset is.
-  out.ray = spawn_ray(sp, s.dir);
-  const vec3 to = sp.p + s.dist * s.dir - out.ray.origin;
-  const float length = sqrtf(glm::dot(to, to));
-  if (!(length > 0.0f)) return out;
-  out.ray.dir = to * (1.0f / length);
-  out.tmax = length * (1.0f - kShadowShorten);
-  // The MIS weight from there, for that direction: the density light_density gives
-  // when a path that leaves here in the same direction hits the light.
-  const float light_pdf = light_density<Kinds>(scene, lm.emission, light.instance, light.prim, out.ray.origin,
-                                               out.ray.dir, length);
-  const float w = power_heuristic(light_pdf, lobe * cos_s * (1.0f / kPi));
-  const vec3 f = albedo * (lobe / kPi);
-  out.contribution = throughput * f * lm.emission * (cos_s * w / (pick * s.pdf));
+  const float bsdf_pdf = bsdf(out.ray.dir);
+  if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
+  // BSDF x cos = albedo x bsdf_pdf (ScatterDensity).
+  out.contribution = throughput * albedo * emitted * (bsdf_pdf * power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
 }
@@ -174,13 +196,12 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
                                float& pdf, ShadowRay& shadow) {
   shadow.valid = false;
   const Material& m = scene.material(material_index<Kinds>(scene, hit));
-  constexpr bool kSampleLights = (Kinds & kLightSampling) != 0;
-  const bool nee = kSampleLights && rp.nee != 0 && scene.light_count() > 0;
+  const bool nee = (Kinds & kLightSampling) != 0 && rp.nee != 0 && scene.light_count() > 0;
   if (m.kind == MaterialKind::Emissive) {
     float w = 1.0f;
-    if (kSampleLights && nee && pdf > 0.0f) {
-      w = power_heuristic(pdf, light_density<Kinds>(scene, m.emission, hit.instance, hit.prim, ray.origin, ray.dir,
-                                                    hit.t));
+    if (nee && pdf > 0.0f) {
+      w = power_heuristic(pdf, light_density(scene, m.emission, emitter_shape<Kinds>(scene, hit.instance, hit.prim),
+                                             ray.origin, ray.dir, hit.t));
     }
     radiance += throughput * m.emission * w;
     return false;
@@ -193,13 +214,14 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const float coat = m.kind == MaterialKind::Coated && sp.front
                          ? schlick(fminf(-glm::dot(ray.dir, facing_n), 1.0f), 1.0f / m.ior)
                          : 0.0f;
-  const float lobe = m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f);
+  const ScatterDensity bsdf{
+      facing_n, m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f)};
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
   const vec3 albedo = material_albedo(m, scene.texture_array(), scene.image_array(), sp);
-  if (kSampleLights && nee && lobe > 0.0f && static_cast<int>(bounce) + 1 < rp.depth) {
-    shadow = sample_light<Kinds>(scene, albedo, sp, facing_n, lobe, throughput, rng);
+  if (nee && bsdf.samples_lights() && static_cast<int>(bounce) + 1 < rp.depth) {
+    shadow = sample_light<Kinds>(scene, albedo, sp, bsdf, throughput, rng);
   }
   vec3 attenuation;
   Ray next;
@@ -207,7 +229,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // The density of the direction the path goes on in, where the BSDF has one: the
   // diffuse lobe's; 0 after a mirror-like bounce (the coat's, when it was drawn).
   const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
-  pdf = lobe > 0.0f && !mirrored ? lobe * fmaxf(glm::dot(next.dir, facing_n), 0.0f) * (1.0f / kPi) : 0.0f;
+  pdf = mirrored ? 0.0f : bsdf(next.dir);
   throughput *= attenuation;
   if (static_cast<int>(bounce) + 1 >= rp.roulette_depth) {
     // Survive with probability p and divide by it: the expectation is unchanged.
@@ -231,7 +253,7 @@ WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint
     Hit hit = intersect_scene<Kinds>(scene, ray);
     ++rays;
     if (hit.missed()) {
-      radiance += throughput * scene.sky.radiance(ray.dir, scene.image_array());
+      radiance += throughput * sky_seen(scene, rp, ray.dir, pdf);
       break;
     }
     ShadowRay shadow;

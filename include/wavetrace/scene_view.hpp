@@ -2,6 +2,7 @@
 #pragma once
 
 #include "wavetrace/camera.hpp"
+#include "wavetrace/distribution.hpp"
 #include "wavetrace/geometry/geometry.hpp"
 #include "wavetrace/lights.hpp"
 #include "wavetrace/material.hpp"
@@ -40,6 +41,10 @@ struct SceneView {
   const float* light_cdf;   // light_cdf[i]: the probability of picking lights 0..i (the last is 1)
   int32_t light_total;
   float light_power;        // the emitters' summed power (light_power_of), which picks them
+  // The sky as a light (lights.hpp's kSkyLight): the probability of picking it (0:
+  // the sky is not sampled), and the environment's table (rows 0: none).
+  float sky_pick;
+  PiecewiseConstant2D environment;
   int32_t node_total;
   uint32_t kinds;  // the primitive kinds present (geometry.hpp), for choosing a kernel
   Sky sky;
@@ -62,6 +67,8 @@ struct SceneView {
   WT_HD LightRef light(int i) const { return lights[i]; }
   WT_HD float light_cdf_at(int i) const { return light_cdf[i]; }
   WT_HD float total_light_power() const { return light_power; }
+  WT_HD float sky_light_pick() const { return sky_pick; }
+  WT_HD const PiecewiseConstant2D& environment_table() const { return environment; }
 };
 
 }  // namespace wt

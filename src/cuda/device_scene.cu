@@ -20,6 +20,8 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   textures_.upload(scene.textures, kStage);
   lights_.upload(scene.lights, kStage);
   light_cdf_.upload(scene.light_cdf, kStage);
+  environment_marginal_.upload(scene.environment.marginal_cdf, kStage);
+  environment_conditional_.upload(scene.environment.conditional_cdf, kStage);
 
   // Texels are fetched one by one (point sampling) and filtered by the shared
   // bilinear code, so the GPU computes exactly what the CPU computes.
@@ -63,6 +65,9 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   view_.light_cdf = light_cdf_.get();
   view_.light_total = static_cast<int32_t>(scene.lights.size());
   view_.light_power = scene.light_power;
+  view_.sky_pick = scene.sky_pick;
+  view_.environment = PiecewiseConstant2D{environment_marginal_.get(), environment_conditional_.get(),
+                                          scene.environment.columns, scene.environment.rows};
   view_.node_total = static_cast<int32_t>(scene.nodes.size());
   view_.kinds = scene.primitive_kinds();
   view_.sky = scene.sky;

@@ -35,6 +35,7 @@ class DeviceScene {
   DeviceBuffer<ImageView> images_;
   DeviceBuffer<LightRef> lights_;
   DeviceBuffer<float> light_cdf_;
+  DeviceBuffer<float> environment_marginal_, environment_conditional_;
   std::vector<cudaArray_t> arrays_;
   std::vector<cudaTextureObject_t> objects_;
   std::vector<ImageView> image_views_;

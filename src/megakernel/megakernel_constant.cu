@@ -21,7 +21,10 @@ struct ConstantLayout {
   uint32_t nodes, instances, spheres, sphere_materials, triangles, triangle_shadings, triangle_materials, normals, uvs,
       materials, textures, images, lights, light_cdf;
   int32_t node_total, light_total;
-  float light_power;
+  float light_power, sky_pick;
+  // The environment's table stays in global memory, as the images do (it can be
+  // megabytes): the device view's pointers.
+  PiecewiseConstant2D environment;
 };
 
 struct ConstantScene {
@@ -52,6 +55,8 @@ struct ConstantScene {
   __device__ LightRef light(int i) const { return array<LightRef>(layout.lights)[i]; }
   __device__ float light_cdf_at(int i) const { return array<float>(layout.light_cdf)[i]; }
   __device__ float total_light_power() const { return layout.light_power; }
+  __device__ float sky_light_pick() const { return layout.sky_pick; }
+  __device__ const PiecewiseConstant2D& environment_table() const { return layout.environment; }
 };
 
 ConstantScene g_scene{};  // host copy of the accessor, filled by upload_constant_scene
@@ -102,6 +107,8 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   cs.layout.node_total = device_view.node_total;
   cs.layout.light_total = device_view.light_total;
   cs.layout.light_power = device_view.light_power;
+  cs.layout.sky_pick = device_view.sky_pick;
+  cs.layout.environment = device_view.environment;
   cs.sky = device_view.sky;
   cs.camera = device_view.camera;
   WT_CUDA(cudaMemcpyToSymbol(c_pool, pool.data(), pool.size()), "constant upload");

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scene/scene.hpp"
+
 namespace wt {
 
 std::vector<float> piecewise_constant_cdf(const std::vector<double>& weights) {

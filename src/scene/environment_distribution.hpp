@@ -1,17 +1,18 @@
 // The tables for importance-sampling the environment sky
-// (include/wavetrace/distribution.hpp), built once per scene on the host.
-//
-// Not yet part of SceneView, the device upload or any kernel: next-event estimation
-// (issue #8) will carry them there.
+// (include/wavetrace/distribution.hpp), built once per scene on the host with the
+// BVH (the scene holds them: Scene::environment) and read through SceneView on
+// every backend.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
-#include "scene/scene.hpp"
 #include "wavetrace/distribution.hpp"
 
 namespace wt {
+
+struct Image;
+struct Scene;
 
 // A texel's luminance: Rec. 709 / sRGB Y of its linear RGB.
 constexpr double kLumaR = 0.2126, kLumaG = 0.7152, kLumaB = 0.0722;

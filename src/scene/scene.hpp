@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scene/bvh_build.hpp"
+#include "scene/environment_distribution.hpp"
 #include "wavetrace/scene_view.hpp"
 
 namespace wt {
@@ -95,9 +96,13 @@ struct Scene {
   std::vector<BvhNode> nodes;
   // The emitters (every emissive primitive of every instance, with the material
   // it shades with) and the table that picks them by power (lights.hpp).
+  // The sky is one of them (kSkyLight) where it is sampled: sky_pick is then the
+  // probability of picking it, and `environment` its table where it has one.
   std::vector<LightRef> lights;
   std::vector<float> light_cdf;
   float light_power = 0.0f;
+  float sky_pick = 0.0f;
+  EnvironmentDistribution environment;
   BvhStats top_level_bvh;
   BvhStats sphere_bvh;
   LoadTimes load_times;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "scene/scene.hpp"
+#include "wavetrace/path.hpp"
 
 namespace wt {
 
@@ -160,21 +161,56 @@ void build_bvh(Scene& scene) {
   build_lights(scene, instance_mesh);
 }
 
-// The emitters of the built instances (instance_mesh[i]: instance i's mesh, or
-// kSpheres), with the table that picks them by power. Their power is computed in
-// float from world-space shapes as the shading code computes it (path.hpp,
-// light_pick_probability), so that both see the same probabilities.
+// The sky's power as a light, in light_power_of's units (power / pi): the radiance
+// that enters the scene's bounding sphere (radius r) from every direction, mean
+// radiance x 4 pi x pi r^2, over pi. 0 where the sky is not sampled: the gradient
+// (the study's skies, which stay as they were rendered) and black skies.
+float sky_light_power(const Scene& scene) {
+  if (scene.nodes.empty()) return 0.0f;
+  const Sky& sky = scene.sky;
+  double mean = 0.0;  // the channels' mean radiance, averaged over the sphere of directions
+  if (sky.kind == SkyKind::Uniform) {
+    mean = (sky.horizon.x + sky.horizon.y + sky.horizon.z) / 3.0;
+  } else if (sky.kind == SkyKind::Environment && sky.image >= 0 &&
+             static_cast<size_t>(sky.image) < scene.images.size()) {
+    const Image& im = scene.images[static_cast<size_t>(sky.image)];
+    // A LatLong row covers solid angle in proportion to sin theta; the other
+    // mappings are averaged over their texels (a guide to the power, not a measure).
+    double weighted = 0.0, weights = 0.0;
+    for (int y = 0; y < im.height; ++y) {
+      const double w = sky.mapping == EnvironmentMapping::LatLong ? std::sin(kPi * (y + 0.5) / im.height) : 1.0;
+      for (int x = 0; x < im.width; ++x) {
+        const float* t = &im.texels[4 * (static_cast<size_t>(y) * im.width + x)];
+        const double v = (static_cast<double>(t[0]) + t[1] + t[2]) / 3.0;
+        weighted += w * (std::isfinite(v) && v > 0.0 ? v : 0.0);
+        weights += w;
+      }
+    }
+    mean = weights > 0.0 ? sky.intensity * weighted / weights : 0.0;
+  }
+  const Aabb box = node_bounds(scene.nodes[0]);
+  const double r = 0.5 * glm::length(box.hi - box.lo);
+  const double power = mean * 4.0 * kPi * r * r;
+  return std::isfinite(power) && power > 0.0 && power < 3.0e38 ? static_cast<float>(power) : 0.0f;
+}
+
+// The lights of the built instances (instance_mesh[i]: instance i's mesh, or
+// kSpheres) and the sky, with the table that picks them by power. An emitter's
+// power is computed in float from its world-space shape as the shading code
+// computes it (path.hpp, light_density), so that both see the same probabilities.
 void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
   scene.lights.clear();
   scene.light_cdf.clear();
   scene.light_power = 0.0f;
+  scene.sky_pick = 0.0f;
+  scene.environment = EnvironmentDistribution{};
   std::vector<float> power;
-  auto add = [&](int32_t instance, uint32_t prim, uint32_t material, float area) {
+  auto add = [&](int32_t instance, uint32_t prim, uint32_t material, const EmitterShape& shape) {
     // (Scenes built by hand in the tests may leave out materials they never shade.)
     if (material >= scene.materials.size()) return;
     const Material& m = scene.materials[material];
     if (m.kind != MaterialKind::Emissive) return;
-    const float p = light_power_of(m.emission, area);
+    const float p = light_power_of(m.emission, shape.area());
     if (!(p > 0.0f)) return;
     scene.lights.push_back(LightRef{instance, static_cast<int32_t>(prim)});
     power.push_back(p);
@@ -184,23 +220,25 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
     const int32_t index = static_cast<int32_t>(i);
     if (in.kind == PrimitiveKind::Sphere) {
       for (size_t p = 0; p < scene.spheres.size(); ++p) {
-        const float r = scene.spheres[p].w;
+        const SphereGeom& sg = scene.spheres[p];
         add(index, static_cast<uint32_t>(p), in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.sphere_material[p],
-            4.0f * kPi * r * r);
+            EmitterShape::of_sphere(vec3(sg.x, sg.y, sg.z), sg.w));
       }
       continue;
     }
     const SceneMesh& mesh = scene.meshes.at(static_cast<size_t>(instance_mesh.at(i)));
     for (uint32_t t = mesh.first_triangle; t < mesh.first_triangle + mesh.triangle_count; ++t) {
-      vec3 a = scene.triangles[t].corner(0), b = scene.triangles[t].corner(1), c = scene.triangles[t].corner(2);
-      if (!in.identity) {
-        a = in.world_from_object.point(a);
-        b = in.world_from_object.point(b);
-        c = in.world_from_object.point(c);
-      }
+      vec3 a, b, c;
+      world_triangle(scene.triangles[t], in, a, b, c);
       add(index, t, in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.triangle_material[t],
-          0.5f * glm::length(glm::cross(b - a, c - a)));
+          EmitterShape::of_triangle(a, b, c));
     }
+  }
+  const float sky = sky_light_power(scene);
+  if (sky > 0.0f) {
+    scene.lights.push_back(LightRef{kSkyLight, 0});
+    power.push_back(sky);
+    scene.environment = build_environment_distribution(scene);
   }
   double total = 0.0;
   for (float p : power) total += p;
@@ -211,6 +249,11 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
     scene.light_cdf.push_back(static_cast<float>(running / total));
   }
   if (!scene.light_cdf.empty()) scene.light_cdf.back() = 1.0f;
+  if (sky > 0.0f) {
+    // As pick_light reads it from the table.
+    const size_t last = scene.light_cdf.size() - 1;
+    scene.sky_pick = scene.light_cdf[last] - (last > 0 ? scene.light_cdf[last - 1] : 0.0f);
+  }
 }
 
 size_t Scene::instanced_triangles() const {
@@ -229,7 +272,8 @@ size_t bytes_of(const std::vector<T>& v) {
 }  // namespace
 
 size_t Scene::device_bytes() const {
-  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(lights) + bytes_of(light_cdf) + bytes_of(spheres) +
+  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(lights) + bytes_of(light_cdf) +
+                 bytes_of(environment.marginal_cdf) + bytes_of(environment.conditional_cdf) + bytes_of(spheres) +
                  bytes_of(sphere_material) +
                  bytes_of(triangles) + bytes_of(triangle_shading) + bytes_of(triangle_material) + bytes_of(normals) +
                  bytes_of(uvs) + bytes_of(materials) + bytes_of(textures);

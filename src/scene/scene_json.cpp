@@ -158,6 +158,8 @@ SceneView host_view(const Scene& scene, int width, int height, std::vector<Image
   v.light_cdf = scene.light_cdf.data();
   v.light_total = static_cast<int32_t>(scene.lights.size());
   v.light_power = scene.light_power;
+  v.sky_pick = scene.sky_pick;
+  v.environment = scene.environment.view();
   v.node_total = static_cast<int32_t>(scene.nodes.size());
   v.kinds = scene.primitive_kinds();
   v.sky = scene.sky;

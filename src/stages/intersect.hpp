@@ -22,7 +22,7 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
   if (h.missed()) {
     const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);
-    accumulate_one(film, q.path[i] % pixels, t * scene.sky.radiance(ray.dir, scene.image_array()));
+    accumulate_one(film, q.path[i] % pixels, t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
     return pack_entry(kSortKeyMiss, i);
   }
   return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);
@@ -74,7 +74,9 @@ struct IntersectItem {
   }
 };
 
-// One item, launched after every intersect item has read the counters.
+// One item, launched after every intersect item has read the counters. It also
+// counts the shadow rays the last bounce traced and empties their queue, which the
+// shadow stage has read by now.
 struct AdvanceCountersItem {
   WaveCounters* counters;
   int cur;
@@ -89,6 +91,8 @@ struct AdvanceCountersItem {
     c.next_path += live - queued;
     c.queued[cur] = live;
     c.queued[1 - cur] = 0;
+    c.shadow_rays += c.shadows;
+    c.shadows = 0;
   }
 };
 

@@ -79,14 +79,4 @@ struct ShadowItem {
   }
 };
 
-// One item after the shadow stage: counts its rays and empties the queue.
-struct FinishShadowsItem {
-  WaveCounters* counters;
-
-  WT_HD void operator()(uint32_t) const {
-    counters->shadow_rays += counters->shadows;
-    counters->shadows = 0;
-  }
-};
-
 }  // namespace wt

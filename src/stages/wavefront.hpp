@@ -1,6 +1,6 @@
 // The wavefront, written once for every backend over an executor that runs named
 // stages: per bounce (generate +) intersect -> compact -> (readback) -> sort ->
-// shade -> shadow (the light samples shade queued, where the scene has emitters and
+// shade -> shadow (the light samples shade queued, where the scene has lights and
 // light sampling is on), with path regeneration keeping the wave full while paths
 // remain. The host
 // reads the counters back once per bounce (after compact), which tells it how many
@@ -116,7 +116,6 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
                                                       list, first, film});
           if (light_sampling && c.hits > 0) {
             ex.launch(stage::kShadow, c.hits, ShadowItem<decltype(kinds)::value>{scene, w.shadows, w.counters, film});
-            ex.launch(stage::kShadow, 1, FinishShadowsItem{w.counters});
           }
         });
         if (last && options.progress) {
