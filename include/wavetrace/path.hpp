@@ -119,24 +119,30 @@ constexpr float kShadowShorten = 1e-4f;
 
 // What light sampling needs of the surface at a hit: the density with which its
 // BSDF samples a direction. For every surface light-sampled here, the BSDF times
-// the cosine is the albedo times that density (a Lambertian lobe's cos / pi, scaled
-// by its share `diffuse` of the reflection), so one function serves both.
+// the cosine is the albedo times that density, so one function serves both: a
+// Lambertian lobe's cos / pi, scaled by its share `diffuse` of the reflection, or a
+// fuzzy metal's lobe about its mirror direction (metal_fuzz_pdf; the directions it
+// would send below the surface are absorbed, so they carry nothing either way).
 struct ScatterDensity {
   vec3 facing_n;
-  float diffuse;  // the diffuse share: 1 for Lambertian; 1 - Fresnel for a coat's base; 0: none
+  float diffuse;   // the diffuse share: 1 for Lambertian; 1 - Fresnel for a coat's base; 0: none
+  vec3 reflected;  // a fuzzy metal's mirror direction
+  float fuzz;      // > 0: a fuzzy metal (diffuse is then 0)
 
   WT_HD float operator()(const vec3& dir) const {
-    return diffuse * fmaxf(glm::dot(dir, facing_n), 0.0f) * (1.0f / kPi);
+    const float cos_n = glm::dot(dir, facing_n);
+    if (fuzz > 0.0f) return cos_n > 0.0f ? metal_fuzz_pdf(reflected, fuzz, dir) : 0.0f;
+    return diffuse * fmaxf(cos_n, 0.0f) * (1.0f / kPi);
   }
-  WT_HD bool samples_lights() const { return diffuse > 0.0f; }
+  WT_HD bool samples_lights() const { return diffuse > 0.0f || fuzz > 0.0f; }
 };
 
 // Next-event estimation at a hit: one light picked by power (an emitter, or the
 // sky), one point or direction on it, and its contribution weighted against the
-// BSDF's sampling of the same direction (the power heuristic). Lambertian surfaces
-// and the diffuse base of coated ones are light-sampled; specular ones (dielectric,
-// mirror metal, a coat's mirror reflection) are not, and the paths they scatter
-// count what they hit in full.
+// BSDF's sampling of the same direction (the power heuristic). Lambertian surfaces,
+// the diffuse base of coated ones and fuzzy metals are light-sampled; specular ones
+// (dielectric, mirror metal, a coat's mirror reflection) are not, and the paths
+// they scatter count what they hit in full.
 template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, const SurfacePoint& sp,
                                        const ScatterDensity& bsdf, const vec3& throughput, const Rng& rng) {
@@ -214,8 +220,10 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const float coat = m.kind == MaterialKind::Coated && sp.front
                          ? schlick(fminf(-glm::dot(ray.dir, facing_n), 1.0f), 1.0f / m.ior)
                          : 0.0f;
+  const bool fuzzy = m.kind == MaterialKind::Metal && m.fuzz > 0.0f;
   const ScatterDensity bsdf{
-      facing_n, m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f)};
+      facing_n, m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f),
+      fuzzy ? reflect(ray.dir, facing_n) : vec3(0.0f), fuzzy ? m.fuzz : 0.0f};
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
@@ -226,8 +234,9 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   vec3 attenuation;
   Ray next;
   if (!scatter_with_albedo(m, albedo, ray, sp, rng, attenuation, next)) return false;
-  // The density of the direction the path goes on in, where the BSDF has one: the
-  // diffuse lobe's; 0 after a mirror-like bounce (the coat's, when it was drawn).
+  // The density of the direction the path goes on in, where the BSDF has one (the
+  // diffuse lobe's, the fuzzy metal's); 0 after a mirror-like bounce (the coat's,
+  // when it was drawn).
   const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
   pdf = mirrored ? 0.0f : bsdf(next.dir);
   throughput *= attenuation;
