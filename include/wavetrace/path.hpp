@@ -80,10 +80,11 @@ WT_HD WT_INLINE float sky_light_density(const Scene& scene, const vec3& dir) {
 // weighted against light sampling where the sky is a sampled light and the path's
 // last bounce (of BSDF density `pdf`; 0 after a specular bounce or the camera)
 // sampled the lights.
-template <class Scene>
+// Kinds without kLightSampling: compiled for scenes with no lights to sample.
+template <uint32_t Kinds = kEverything, class Scene>
 WT_HD WT_INLINE vec3 sky_seen(const Scene& scene, const RenderParams& rp, const vec3& dir, float pdf) {
   const vec3 sky = scene.sky.radiance(dir, scene.image_array());
-  if (rp.nee == 0 || !(pdf > 0.0f) || !(scene.sky_light_pick() > 0.0f)) return sky;
+  if ((Kinds & kLightSampling) == 0 || !(pdf > 0.0f) || rp.nee == 0 || !(scene.sky_light_pick() > 0.0f)) return sky;
   return sky * power_heuristic(pdf, sky_light_density(scene, dir));
 }
 
@@ -220,7 +221,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const float coat = m.kind == MaterialKind::Coated && sp.front
                          ? schlick(fminf(-glm::dot(ray.dir, facing_n), 1.0f), 1.0f / m.ior)
                          : 0.0f;
-  const bool fuzzy = m.kind == MaterialKind::Metal && m.fuzz > 0.0f;
+  const bool fuzzy = nee && m.kind == MaterialKind::Metal && m.fuzz > 0.0f;
   const ScatterDensity bsdf{
       facing_n, m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f),
       fuzzy ? reflect(ray.dir, facing_n) : vec3(0.0f), fuzzy ? m.fuzz : 0.0f};
@@ -238,7 +239,8 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // diffuse lobe's, the fuzzy metal's); 0 after a mirror-like bounce (the coat's,
   // when it was drawn).
   const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
-  pdf = mirrored ? 0.0f : bsdf(next.dir);
+  // (Only light sampling's MIS weights read it.)
+  pdf = nee && !mirrored ? bsdf(next.dir) : 0.0f;
   throughput *= attenuation;
   if (static_cast<int>(bounce) + 1 >= rp.roulette_depth) {
     // Survive with probability p and divide by it: the expectation is unchanged.
@@ -262,7 +264,7 @@ WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint
     Hit hit = intersect_scene<Kinds>(scene, ray);
     ++rays;
     if (hit.missed()) {
-      radiance += throughput * sky_seen(scene, rp, ray.dir, pdf);
+      radiance += throughput * sky_seen<Kinds>(scene, rp, ray.dir, pdf);
       break;
     }
     ShadowRay shadow;
