@@ -31,7 +31,7 @@ else
 fi
 python3 bench/mesh_tables.py "${mesh_results[@]}" >"$results/meshes/tables.md" || status=$?
 # A picture of each mesh scene from each GPU kernel.
-for scene in scenes/cornell-box.json scenes/terrain.json scenes/instances.json scenes/generated/*.json; do
+for scene in scenes/cornell-box.json scenes/glossy-lights.json scenes/sky-sun.json scenes/terrain.json scenes/instances.json scenes/generated/*.json; do
   [[ -f "$scene" ]] || continue
   for kernel in $("$bin/wavetrace" kernels --backend cuda); do
     "$bin/wavetrace" render "$scene" -o "$results/meshes/$(basename "$scene" .json)-$kernel.png" --width 480 \
