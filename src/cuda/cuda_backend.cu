@@ -32,9 +32,6 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   DeviceBuffer<float> film(pixels * 3, kStage);
   DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
-  // Each pass's counter of pixels taken (megakernel_body.cuh): passes are queued
-  // without waiting, so each has its own, zeroed before the first.
-  DeviceBuffer<unsigned int> next_pixel(passes.size(), kStage);
 
   RenderResult out;
   auto run = [&](bool last) {
@@ -44,7 +41,6 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
       film.zero(kStage);
     }
     rays.zero(kStage);
-    next_pixel.zero(kStage);
     out.samples = options.first_sample;
     out.interrupted = false;
     out.paths = 0;
@@ -54,9 +50,9 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
       if (constant) {
-        launch_megakernel_constant(rp, pass.first, pass.count, film.get(), rays.get(), next_pixel.get() + p, nullptr);
+        launch_megakernel_constant(rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
       } else {
-        launch_megakernel(ds.view(), rp, pass.first, pass.count, film.get(), rays.get(), next_pixel.get() + p, nullptr);
+        launch_megakernel(ds.view(), rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
       }
       pass_done[p].record("megakernel");
       out.samples = pass.first + pass.count;

@@ -12,9 +12,8 @@ namespace wt::cuda {
 
 // Adds samples [first_sample, first_sample + samples) of every pixel to film (RGB
 // sums), the path rays they intersect to rays[0] and the shadow rays to rays[1].
-// next_pixel: a counter the launch's threads take pixels from, 0 at launch.
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
-                       unsigned long long* rays, unsigned int* next_pixel, cudaStream_t stream);
+                       unsigned long long* rays, cudaStream_t stream);
 
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();
@@ -24,6 +23,6 @@ size_t constant_scene_capacity();
 void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images);
 
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
-                                unsigned long long* rays, unsigned int* next_pixel, cudaStream_t stream);
+                                unsigned long long* rays, cudaStream_t stream);
 
 }  // namespace wt::cuda

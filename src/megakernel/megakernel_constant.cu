@@ -65,10 +65,10 @@ uint32_t g_kinds = kAllKinds;  // the uploaded scene's primitive kinds
 size_t align16(size_t n) { return (n + 15) & ~size_t(15); }
 
 template <uint32_t Kinds>
-__global__ void __launch_bounds__(kMegakernelThreads, kMegakernelMinBlocksPerSm)
+__global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
     megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, float* film,
-                        unsigned long long* rays, unsigned int* next_pixel) {
-  megakernel_thread<Kinds>(scene, rp, first_sample, samples, film, rays, next_pixel);
+                        unsigned long long* rays) {
+  megakernel_pixel<Kinds>(scene, rp, first_sample, samples, film, rays);
 }
 
 }  // namespace
@@ -117,12 +117,12 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
 }
 
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
-                                unsigned long long* rays, unsigned int* next_pixel, cudaStream_t stream) {
+                                unsigned long long* rays, cudaStream_t stream) {
+  const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
   const uint32_t kinds_and_lights = g_kinds | (rp.nee != 0 && g_scene.layout.light_total > 0 ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {
-    const auto kernel = megakernel_constant<decltype(kinds)::value>;
-    kernel<<<megakernel_grid(kernel, rp, "megakernel-constant"), kMegakernelThreads, 0, stream>>>(
-        g_scene, rp, first_sample, samples, film, rays, next_pixel);
+    megakernel_constant<decltype(kinds)::value>
+        <<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);
   });
   WT_CUDA_LAUNCHED("megakernel_constant", "megakernel-constant");
 }
