@@ -52,6 +52,7 @@ KERNEL_STYLE = {
     "megakernel": ("#1f77b4", "o"),
     "megakernel-constant": ("#17becf", "s"),
     "wavefront": ("#d62728", "^"),
+    "wavefront-sorted": ("#9467bd", "P"),
     "wavefront-unsorted": ("#ff7f0e", "v"),
 }
 EXTRA_STYLES = [("#2ca02c", "D"), ("#9467bd", "P"), ("#8c564b", "X"), ("#e377c2", "*")]

@@ -57,10 +57,10 @@ TEST_P(GoldenImage, IsBitIdentical) {
 std::vector<Golden> every_golden() {
   std::vector<Golden> out;
   for (const char* scene : {"seed57", "rtiow-cover", "divergent"}) {
-    for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+    for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
       out.push_back({scene, Backend::Cpu, k});
     }
-    for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+    for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
       out.push_back({scene, Backend::Cuda, k});
     }
   }

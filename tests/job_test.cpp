@@ -382,7 +382,7 @@ TEST_F(JobTest, BenchSpecMistakesNameTheirPath) {
                    "roulette_depth, seed, nee)");
   EXPECT_EQ(error_with("\"wavefront\"]", "\"wavefrnt\"]"),
             spec + ": /groups/0/kernels/1: unknown value 'wavefrnt' (expected megakernel, megakernel-constant, "
-                   "wavefront, wavefront-unsorted)");
+                   "wavefront, wavefront-sorted, wavefront-unsorted)");
   EXPECT_EQ(error_with("\"spp\": 4, ", ""), spec + ": /groups/1/configs/0/spp: required key is missing");
   EXPECT_EQ(error_with("\"spp\": 4", "\"spp\": 0"),
             spec + ": /groups/1/configs/0/spp: must be an integer in 1..1000000 (got 0)");

@@ -377,7 +377,7 @@ TEST(GlossyLightSampling, EveryCudaKernelAgreesWithTheCpuMegakernel) {
 // only the order of the film's additions differs (a path's terms arrive one by one).
 TEST(LightSamplingRender, CpuWavefrontMatchesCpuMegakernelToRounding) {
   const RenderResult mk = cornell(Kernel::Megakernel, 4, 9, 1);
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
     const RenderResult wf = cornell(k, 4, 9, 1);
     ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
     for (size_t i = 0; i < mk.rgb.size(); ++i) {

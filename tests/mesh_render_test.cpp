@@ -94,7 +94,7 @@ RenderResult render_cornell(Backend b, Kernel k, int spp, uint32_t seed = 5, int
 TEST(CornellBox, CpuWavefrontIsBitIdenticalToCpuMegakernel) {
   const RenderResult mk = render_cornell(Backend::Cpu, Kernel::Megakernel, 2, 5, 0);
   EXPECT_GT(mean(mk.rgb), 0.01) << "the box should be lit";
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
     const RenderResult wf = render_cornell(Backend::Cpu, k, 2, 5, 0);
     ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
     size_t differing = 0;

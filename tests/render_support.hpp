@@ -32,9 +32,10 @@ inline std::string variant_name(const testing::TestParamInfo<Variant>& info) {
 
 // Every kernel on every backend that runs it (the CUDA ones skip without a device).
 inline std::vector<Variant> all_variants() {
-  return {{Backend::Cpu, Kernel::Megakernel},           {Backend::Cpu, Kernel::Wavefront},
-          {Backend::Cpu, Kernel::WavefrontUnsorted},    {Backend::Cuda, Kernel::Megakernel},
-          {Backend::Cuda, Kernel::MegakernelConstant},  {Backend::Cuda, Kernel::Wavefront},
+  return {{Backend::Cpu, Kernel::Megakernel},          {Backend::Cpu, Kernel::Wavefront},
+          {Backend::Cpu, Kernel::WavefrontSorted},     {Backend::Cpu, Kernel::WavefrontUnsorted},
+          {Backend::Cuda, Kernel::Megakernel},         {Backend::Cuda, Kernel::MegakernelConstant},
+          {Backend::Cuda, Kernel::Wavefront},          {Backend::Cuda, Kernel::WavefrontSorted},
           {Backend::Cuda, Kernel::WavefrontUnsorted}};
 }
 
@@ -72,7 +73,7 @@ void expect_cuda_agrees_with_cpu(Render render, uint32_t seed) {
   const RenderResult other_seed = render(Backend::Cpu, Kernel::Megakernel, seed + 1);
   const double independent = mean_abs_diff(cpu.rgb, other_seed.rgb);
   ASSERT_GT(independent, 1e-3) << "two seeds should give visibly different noise";
-  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
     const RenderResult gpu = render(Backend::Cuda, k, seed);
     ASSERT_EQ(gpu.rgb.size(), cpu.rgb.size()) << kernel_name(k);
     const double mad = mean_abs_diff(cpu.rgb, gpu.rgb);

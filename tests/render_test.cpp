@@ -9,6 +9,7 @@
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
 #include "render/renderer.hpp"
+#include "stages/wavefront.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 
@@ -197,17 +198,53 @@ RenderResult render_quick(Backend b, Kernel k) {
 
 TEST(KernelAgreement, CpuWavefrontMatchesCpuMegakernel) {
   RenderResult mk = render_quick(Backend::Cpu, Kernel::Megakernel);
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
     RenderResult wf = render_quick(Backend::Cpu, k);
     EXPECT_LT(mean_abs_diff(mk.rgb, wf.rgb), kSameBackendBound) << kernel_name(k);
     EXPECT_EQ(mk.rays, wf.rays) << kernel_name(k);
   }
 }
 
+// The sort policy (stages/wavefront.hpp): forced modes always and never sort; the
+// adaptive one sorts a bounce whose hits hold at least kSortMinKeys sort keys.
+TEST(SortPolicy, SortsOnlyBouncesWithManyKindsOfShading) {
+  EXPECT_TRUE(sorts_bounce(Kernel::WavefrontSorted, 0u));
+  EXPECT_FALSE(sorts_bounce(Kernel::WavefrontUnsorted, 0xffffffffu));
+  EXPECT_FALSE(sorts_bounce(Kernel::Wavefront, (1u << (kSortMinKeys - 1)) - 1u));
+  EXPECT_TRUE(sorts_bounce(Kernel::Wavefront, (1u << kSortMinKeys) - 1u));
+  EXPECT_TRUE(sorts_bounce(Kernel::Wavefront, 0x55555u)) << "ten keys, not adjacent";
+  EXPECT_FALSE(sorts_bounce(Kernel::Wavefront, 0x80000001u)) << "two keys, far apart";
+}
+
+// In whole renders, on both backends' wavefront: quick.json's hits hold eight sort
+// keys (five materials kinds, four texture kinds) and its first bounces are sorted;
+// rtiow-cover's three never are; the forced modes sort every bounce or none. The
+// bounce counts are the same in every mode: sorting reorders, it does not change
+// which paths are traced.
+TEST(SortPolicy, TheWavefrontSortsWhereTheHitsHoldManyKeys) {
+  std::vector<Backend> backends = {Backend::Cpu};
+  if (test::cuda_available()) backends.push_back(Backend::Cuda);
+  const Scene quick = load_scene(test::repo_path("scenes/quick.json"));
+  const Scene rtiow = load_scene(test::repo_path("scenes/rtiow-cover.json"));
+  for (Backend b : backends) {
+    const RenderResult q = render(quick, options_for(b, Kernel::Wavefront, 96, 54, 2, 8, 3, 5));
+    EXPECT_GT(q.bounces_sorted, 0u) << backend_name(b);
+    const RenderResult r = render(rtiow, options_for(b, Kernel::Wavefront, 64, 36, 2, 8, 3, 5));
+    EXPECT_GT(r.bounces_shaded, 0u) << backend_name(b);
+    EXPECT_EQ(r.bounces_sorted, 0u) << backend_name(b);
+    const RenderResult sorted = render(rtiow, options_for(b, Kernel::WavefrontSorted, 64, 36, 2, 8, 3, 5));
+    EXPECT_EQ(sorted.bounces_sorted, sorted.bounces_shaded) << backend_name(b);
+    EXPECT_EQ(sorted.bounces_shaded, r.bounces_shaded) << backend_name(b);
+    const RenderResult unsorted = render(quick, options_for(b, Kernel::WavefrontUnsorted, 96, 54, 2, 8, 3, 5));
+    EXPECT_EQ(unsorted.bounces_sorted, 0u) << backend_name(b);
+    EXPECT_EQ(unsorted.bounces_shaded, q.bounces_shaded) << backend_name(b);
+  }
+}
+
 TEST(KernelAgreement, CudaKernelsMatchCudaMegakernel) {
   WT_REQUIRE_CUDA();
   RenderResult mk = render_quick(Backend::Cuda, Kernel::Megakernel);
-  for (Kernel k : {Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontUnsorted}) {
+  for (Kernel k : {Kernel::MegakernelConstant, Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
     RenderResult other = render_quick(Backend::Cuda, k);
     EXPECT_LT(mean_abs_diff(mk.rgb, other.rgb), kSameBackendBound) << kernel_name(k);
     // Ray counts may differ only where rounding changed a path's length.

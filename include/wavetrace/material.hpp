@@ -29,6 +29,7 @@ WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /
 }
 constexpr uint32_t kSortKeyCount = kMaterialKindCount * 4;
 constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene sort last
+static_assert(kSortKeyCount <= 32, "a bounce's sort keys are gathered as the bits of one word");
 
 WT_HD WT_INLINE vec3 material_albedo(const Material& m, const Texture* textures, const ImageView* images,
                                      const SurfacePoint& sp) {

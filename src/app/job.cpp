@@ -123,6 +123,8 @@ void print_profile(const RenderResult& r) {
     std::fprintf(stderr, " %llu", static_cast<unsigned long long>(r.live_per_bounce[i]));
   }
   std::fprintf(stderr, r.live_per_bounce.size() > 40 ? " ...\n" : "\n");
+  std::fprintf(stderr, "bounces sorted: %llu of %llu\n", static_cast<unsigned long long>(r.bounces_sorted),
+               static_cast<unsigned long long>(r.bounces_shaded));
 }
 
 // After a device failure: an error that left the context usable is cleared; a sticky

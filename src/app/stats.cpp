@@ -67,6 +67,8 @@ void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, 
     for (const StageTime& s : r.stages) stages[s.name] = s.ms;
     j["stage_ms"] = stages;
     j["live_per_bounce"] = r.live_per_bounce;
+    j["bounces_shaded"] = r.bounces_shaded;
+    j["bounces_sorted"] = r.bounces_sorted;
   }
 }
 

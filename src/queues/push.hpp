@@ -26,4 +26,19 @@ WT_HD WT_INLINE uint32_t push_slot(uint32_t* count, bool want) {
 #endif
 }
 
+// Sets `bits` in *mask, from many threads. On the GPU the warp's bits are gathered
+// first, and its leader writes only those *mask lacks (most warps, once the common
+// keys are in, write nothing); on host threads one atomic OR.
+WT_HD WT_INLINE void or_bits(uint32_t* mask, uint32_t bits) {
+#if defined(__CUDA_ARCH__)
+  const unsigned active = __activemask();
+  const uint32_t warp_bits = __reduce_or_sync(active, bits);
+  if ((threadIdx.x & 31) == static_cast<unsigned>(__ffs(active) - 1) && (warp_bits & ~*mask) != 0) {
+    atomicOr(mask, warp_bits);
+  }
+#else
+  if (bits) __atomic_fetch_or(mask, bits, __ATOMIC_RELAXED);
+#endif
+}
+
 }  // namespace wt

@@ -18,6 +18,10 @@ struct WaveCounters {
   uint32_t hits;       // entries compact kept this bounce
   uint64_t rays;       // rays intersected, all bounces
   uint32_t shadows;    // shadow rays shade queued this bounce
+  // The sort keys among the hits of the bounce traced from queue[cur] (bit k: key k),
+  // which decide whether that bounce is sorted; each bounce's counter update clears
+  // the next bounce's.
+  uint32_t key_mask[2];
   uint32_t unused;
   uint64_t shadow_rays;  // shadow rays traced, all bounces
 };

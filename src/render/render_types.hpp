@@ -14,9 +14,14 @@
 namespace wt {
 
 enum class Backend { Cpu, Cuda };
-enum class Kernel { Megakernel, MegakernelConstant, Wavefront, WavefrontUnsorted };
+// Wavefront sorts a bounce's hits by material where they hold enough kinds of
+// shading (stages/wavefront.hpp); WavefrontSorted and WavefrontUnsorted always and
+// never do.
+enum class Kernel { Megakernel, MegakernelConstant, Wavefront, WavefrontSorted, WavefrontUnsorted };
 
-inline bool is_wavefront(Kernel k) { return k == Kernel::Wavefront || k == Kernel::WavefrontUnsorted; }
+inline bool is_wavefront(Kernel k) {
+  return k == Kernel::Wavefront || k == Kernel::WavefrontSorted || k == Kernel::WavefrontUnsorted;
+}
 
 // Progress of a render: fraction of paths done, rays so far, seconds since start.
 using ProgressFn = std::function<void(double done, uint64_t rays, double seconds)>;
@@ -77,6 +82,8 @@ struct RenderResult {
   std::string device;
   std::vector<StageTime> stages;          // wavefront: each stage's time, summed over bounces
   std::vector<uint64_t> live_per_bounce;  // wavefront: paths alive entering each bounce
+  // wavefront: the bounces (wave steps) with hits, and those whose hits were sorted
+  uint64_t bounces_shaded = 0, bounces_sorted = 0;
 };
 
 }  // namespace wt

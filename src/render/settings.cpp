@@ -86,6 +86,7 @@ const std::vector<KernelInfo>& kernel_table() {
       {Kernel::Megakernel, "megakernel", false},
       {Kernel::MegakernelConstant, "megakernel-constant", true},
       {Kernel::Wavefront, "wavefront", false},
+      {Kernel::WavefrontSorted, "wavefront-sorted", false},
       {Kernel::WavefrontUnsorted, "wavefront-unsorted", false},
   };
   return table;

@@ -5,6 +5,7 @@
 // emptied for shade's pushes.
 #pragma once
 
+#include "queues/push.hpp"
 #include "queues/wave.hpp"
 #include "stages/accumulate.hpp"
 #include "stages/generate.hpp"
@@ -48,7 +49,7 @@ struct IntersectItem {
   PathQueue queue;
   HitQueue hits;
   uint32_t* entries;
-  const WaveCounters* counters;
+  WaveCounters* counters;  // read, but for the key mask this bounce's hits set
   int cur;
   uint32_t total_paths;  // of this pass
   uint32_t first_sample;  // of this pass
@@ -70,7 +71,10 @@ struct IntersectItem {
     } else {
       ray = queued_ray(queue, i);
     }
-    entries[i] = intersect_one<Kinds>(i, ray, scene, rp, queue, hits, film);
+    const uint32_t entry = intersect_one<Kinds>(i, ray, scene, rp, queue, hits, film);
+    entries[i] = entry;
+    const uint32_t key = entry_key(entry);
+    or_bits(&counters->key_mask[cur], key < kSortKeyMiss ? 1u << key : 0u);
   }
 };
 
@@ -93,6 +97,7 @@ struct AdvanceCountersItem {
     c.queued[1 - cur] = 0;
     c.shadow_rays += c.shadows;
     c.shadows = 0;
+    c.key_mask[1 - cur] = 0;
   }
 };
 

@@ -1,6 +1,6 @@
 // The wavefront, written once for every backend over an executor that runs named
-// stages: per bounce (generate +) intersect -> compact -> (readback) -> sort ->
-// shade -> shadow (the light samples shade queued, where the scene has lights and
+// stages: per bounce (generate +) intersect -> compact -> (readback) -> sort (where
+// it pays: sorts_bounce) -> shade -> shadow (the light samples shade queued, where the scene has lights and
 // light sampling is on), with path regeneration keeping the wave full while paths
 // remain. The host
 // reads the counters back once per bounce (after compact), which tells it how many
@@ -46,6 +46,23 @@ constexpr Stage kShadow{5, "shadow"};
 constexpr std::array<Stage, 6> kAll = {kIntersect, kCompact, kReadback, kSort, kShade, kShadow};
 }  // namespace stage
 
+// `wavefront` sorts a bounce's hits when they hold at least this many sort keys
+// (kinds of shading work: material kind x texture kind), read from the mask
+// intersect gathers. Measured on the H100 (bench/RESULTS.md, "A sort that pays or
+// is skipped"): seed57, rtiow-cover and sky-sun (3-5 keys) shade no faster sorted
+// and lose the sort's time; divergent (9 keys, noise textures among them) shades
+// 1.6x faster sorted, far more than the sort costs.
+constexpr int kSortMinKeys = 6;
+
+// Whether `kernel` sorts a bounce whose hits hold the sort keys of `key_mask`.
+inline bool sorts_bounce(Kernel kernel, uint32_t key_mask) {
+  if (kernel == Kernel::WavefrontSorted) return true;
+  if (kernel == Kernel::WavefrontUnsorted) return false;
+  int keys = 0;
+  for (uint32_t m = key_mask; m != 0; m &= m - 1) ++keys;
+  return keys >= kSortMinKeys;
+}
+
 // Bytes a wave of `capacity` slots takes on the executor's memory.
 template <class Exec>
 size_t wavefront_bytes(size_t capacity) {
@@ -58,7 +75,6 @@ template <class Exec>
 RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, const RenderOptions& options,
                               int64_t capacity) {
   const RenderParams& rp = options.params;
-  const bool sorted = options.kernel == Kernel::Wavefront;
   const bool light_sampling = rp.nee != 0 && scene.light_total > 0;
   const uint32_t shade_kinds = scene.kinds | (light_sampling ? kLightSampling : 0u);
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
@@ -85,7 +101,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       ex.zero(film, film_floats * sizeof(float));
     }
     std::vector<uint64_t> live_per_bounce;
-    uint64_t rays = 0, shadow_rays = 0, paths_done = 0;
+    uint64_t rays = 0, shadow_rays = 0, paths_done = 0, bounces_shaded = 0, bounces_sorted = 0;
     out.samples = options.first_sample;
     out.interrupted = false;
     ex.start_timer();
@@ -106,7 +122,9 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         live_per_bounce.push_back(c.queued[cur]);
 
         const uint32_t* list = w.selected;
-        if (sorted && c.hits > 0) {
+        if (c.hits > 0) ++bounces_shaded;
+        if (c.hits > 0 && sorts_bounce(options.kernel, c.key_mask[cur])) {
+          ++bounces_sorted;
           list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
         }
         with_kinds(shade_kinds, [&](auto kinds) {
@@ -139,6 +157,8 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
     out.seconds = ex.stop_timer();
     out.rays = rays;
     out.shadow_rays = shadow_rays;
+    out.bounces_shaded = bounces_shaded;
+    out.bounces_sorted = bounces_sorted;
     out.paths = paths_done;
     const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
     out.stages.clear();
