@@ -252,52 +252,32 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   return true;
 }
 
-// A path being traced one ray at a time: trace_path runs it to its end, and the
-// megakernel's lanes interleave it with their other paths (megakernel_body.cuh).
-struct PathInFlight {
-  Ray ray;            // the next ray to trace
-  vec3 throughput;
-  vec3 radiance;      // gathered so far
-  float pdf;          // the last bounce's BSDF density, for MIS (shade_hit)
-  uint32_t bounce;    // rays traced so far
-};
-
-template <class Scene>
-WT_HD WT_INLINE PathInFlight begin_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample) {
-  return PathInFlight{primary_ray(scene, rp, pixel, sample), vec3(1.0f), vec3(0.0f), 0.0f, 0u};
-}
-
-// Traces the path's next ray and shades what it meets (and its light sample);
-// false once the path is done, its radiance final. `rays` grows by the path ray,
-// `shadow_rays` by the shadow ray traced, if any.
-template <uint32_t Kinds = kEverything, class Scene>
-WT_HD WT_INLINE bool advance_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample,
-                                  PathInFlight& path, uint32_t& rays, uint32_t& shadow_rays) {
-  const Hit hit = intersect_scene<Kinds>(scene, path.ray);
-  ++rays;
-  if (hit.missed()) {
-    path.radiance += path.throughput * sky_seen<Kinds>(scene, rp, path.ray.dir, path.pdf);
-    return false;
-  }
-  ShadowRay shadow;
-  const bool alive = shade_hit<Kinds>(scene, rp, hit, pixel, sample, path.bounce, path.ray, path.throughput,
-                                      path.radiance, path.pdf, shadow);
-  if ((Kinds & kLightSampling) && shadow.valid) {
-    ++shadow_rays;
-    if (!occluded<Kinds>(scene, shadow.ray, shadow.tmax)) path.radiance += shadow.contribution;
-  }
-  return alive && static_cast<int>(++path.bounce) < rp.depth;
-}
-
 // The radiance of path (pixel, sample); `rays` grows by every path ray intersected,
 // `shadow_rays` by every shadow ray traced.
 template <uint32_t Kinds = kEverything, class Scene>
 WT_HD WT_INLINE vec3 trace_path(const Scene& scene, const RenderParams& rp, uint32_t pixel, uint32_t sample,
                                 uint32_t& rays, uint32_t& shadow_rays) {
-  PathInFlight path = begin_path(scene, rp, pixel, sample);
-  while (advance_path<Kinds>(scene, rp, pixel, sample, path, rays, shadow_rays)) {
+  Ray ray = primary_ray(scene, rp, pixel, sample);
+  vec3 throughput(1.0f), radiance(0.0f);
+  float pdf = 0.0f;
+  for (int bounce = 0; bounce < rp.depth; ++bounce) {
+    Hit hit = intersect_scene<Kinds>(scene, ray);
+    ++rays;
+    if (hit.missed()) {
+      radiance += throughput * sky_seen<Kinds>(scene, rp, ray.dir, pdf);
+      break;
+    }
+    ShadowRay shadow;
+    const bool alive =
+        shade_hit<Kinds>(scene, rp, hit, pixel, sample, static_cast<uint32_t>(bounce), ray, throughput, radiance, pdf,
+                         shadow);
+    if ((Kinds & kLightSampling) && shadow.valid) {
+      ++shadow_rays;
+      if (!occluded<Kinds>(scene, shadow.ray, shadow.tmax)) radiance += shadow.contribution;
+    }
+    if (!alive) break;
   }
-  return path.radiance;
+  return radiance;
 }
 
 }  // namespace wt
