@@ -1,0 +1,1547 @@
+#!/usr/bin/env python3
+"""Mitsuba 3 as a peer in the benchmark: wavetrace's scenes converted to Mitsuba
+scene dicts, and rendered with Mitsuba's path tracer, timed as wavetrace's
+renders are (one warm-up render, then the median of 3).
+
+    python3 bench/mitsuba_peer.py convert SCENE.json [--width W ...]   # the dict and the notes
+    python3 bench/mitsuba_peer.py render SCENE.json --width W --height H --spp N --depth D
+            [--roulette-depth R] [--seed S] [--mode symbolic|evaluated|both]
+            [--variant cuda_ad_rgb] [-o OUT_PREFIX] [--json RESULTS.json]
+
+The conversion (everything up to `load_scene`) is plain Python and never imports
+Mitsuba: it builds a dict of plain values in which a transform is written
+{"__transform__": 4x4 rows}; `load_scene` turns those into Mitsuba transforms,
+registers the few Python plugins the dict names and calls mi.load_dict. Mesh
+parts and procedural images that Mitsuba has to read from files (split OBJ files,
+PLY files from glTF, PFM skies) are written to a cache folder
+($WAVETRACE_PEER_CACHE, default $TMPDIR/wavetrace-mitsuba-peer).
+
+What does not map exactly is collected as notes: printed by both commands and
+stored with every record of `render`. The mapping and its approximations are
+listed in bench/README.md ("Mitsuba 3 peer").
+"""
+
+import argparse
+import array
+import base64
+import hashlib
+import json
+import math
+import os
+import platform
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+
+CONVERTER_VERSION = 1
+
+# Every Mitsuba plugin type the converter can emit (scripts/peer-pack.sh keeps
+# these, and what they load, in the trimmed package).
+EMITTED_PLUGINS = (
+    "scene", "path", "perspective", "thinlens", "hdrfilm", "box", "independent",
+    "sphere", "obj", "ply", "shapegroup", "instance",
+    "diffuse", "twosided", "conductor", "roughconductor", "dielectric", "plastic",
+    "area", "constant", "envmap", "bitmap", "rgb",
+)
+# Python plugins registered by load_scene when a dict names them.
+PYTHON_PLUGINS = ("wt_checker", "wt_scale", "wt_null")
+
+# Metal fuzz -> Beckmann roughness: equal mean-square slope of the half vector
+# at normal incidence. wavetrace's fuzzy mirror turns the reflection r into
+# normalize(r + fuzz s), s uniform on the unit sphere; for small fuzz the
+# deviation angle has E[theta^2] = (2/3) fuzz^2, and the half vector deviates by
+# theta / 2, so E[tan^2 theta_h] = fuzz^2 / 6, which is alpha^2 for Beckmann.
+# (Measured by sampling: alpha_rms / fuzz = 0.408 at fuzz 0.1, 0.420 at 0.5,
+# 0.477 at 1.)
+FUZZ_TO_ALPHA = 1.0 / math.sqrt(6.0)
+
+# A gradient sky becomes a lat-long image of this size (rows sit at
+# v = i / (rows - 1), where Mitsuba's envmap puts them; columns are all alike).
+GRADIENT_SKY_ROWS = 129
+GRADIENT_SKY_COLUMNS = 8
+# Angular and mirror-ball environments are resampled to a lat-long image of
+# this many rows (and twice as many columns) when the scene is loaded.
+RESAMPLED_SKY_ROWS = 512
+
+
+class ConversionError(Exception):
+    pass
+
+
+# --------------------------------------------------------------------------
+# 4x4 matrices as lists of rows (pure Python)
+# --------------------------------------------------------------------------
+
+def mat_identity():
+    return [[1.0 if r == c else 0.0 for c in range(4)] for r in range(4)]
+
+
+def mat_mul(a, b):
+    return [[sum(a[r][k] * b[k][c] for k in range(4)) for c in range(4)] for r in range(4)]
+
+
+def mat_translate(t):
+    m = mat_identity()
+    for i in range(3):
+        m[i][3] = float(t[i])
+    return m
+
+
+def mat_scale(s):
+    if isinstance(s, (int, float)):
+        s = (s, s, s)
+    m = mat_identity()
+    for i in range(3):
+        m[i][i] = float(s[i])
+    return m
+
+
+def mat_rotate(axis, degrees):
+    """Right-handed rotation about a coordinate axis ('x', 'y' or 'z'), as glm::rotate."""
+    a = math.radians(degrees)
+    c, s = math.cos(a), math.sin(a)
+    m = mat_identity()
+    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
+    m[i][i], m[i][j], m[j][i], m[j][j] = c, -s, s, c
+    return m
+
+
+def mat_det3(m):
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def mat_inverse_affine(m):
+    d = mat_det3(m)
+    if d == 0 or not math.isfinite(d):
+        raise ConversionError("singular transform")
+    inv = [[0.0] * 4 for _ in range(4)]
+    for r in range(3):
+        for c in range(3):
+            r1, r2 = [k for k in range(3) if k != c]
+            c1, c2 = [k for k in range(3) if k != r]
+            minor = m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]
+            inv[r][c] = (-1) ** (r + c) * minor / d
+    for r in range(3):
+        inv[r][3] = -sum(inv[r][k] * m[k][3] for k in range(3))
+    inv[3][3] = 1.0
+    return inv
+
+
+def mat_point(m, p):
+    return [m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3] for r in range(3)]
+
+
+def is_identity(m):
+    return all(abs(m[r][c] - (1.0 if r == c else 0.0)) == 0.0 for r in range(4) for c in range(4))
+
+
+def transform(m):
+    """A transform in the dict, turned into mi.ScalarTransform4f by load_scene."""
+    return {"__transform__": [list(map(float, row)) for row in m]}
+
+
+def instance_matrix(inst):
+    """wavetrace's placement: 'matrix' (rows), or translate x Rz x Ry x Rx x scale."""
+    if "matrix" in inst:
+        v = inst["matrix"]
+        return [[float(v[4 * r + c]) for c in range(4)] for r in range(4)]
+    m = mat_identity()
+    if "translate" in inst:
+        m = mat_mul(m, mat_translate(inst["translate"]))
+    if "rotate" in inst:
+        rx, ry, rz = inst["rotate"]
+        m = mat_mul(m, mat_rotate("z", rz))
+        m = mat_mul(m, mat_rotate("y", ry))
+        m = mat_mul(m, mat_rotate("x", rx))
+    if "scale" in inst:
+        m = mat_mul(m, mat_scale(inst["scale"]))
+    return m
+
+
+def look_at_matrix(origin, target, up):
+    """Camera-to-world as Mitsuba's look_at builds it: columns (left, up, forward, origin)."""
+    def sub(a, b):
+        return [a[i] - b[i] for i in range(3)]
+
+    def cross(a, b):
+        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+    def norm(a):
+        n = math.sqrt(sum(x * x for x in a))
+        return [x / n for x in a]
+
+    d = norm(sub(target, origin))
+    left = norm(cross(norm(up), d))
+    new_up = cross(d, left)
+    return [[left[i], new_up[i], d[i], float(origin[i])] for i in range(3)] + [[0.0, 0.0, 0.0, 1.0]]
+
+
+# Mitsuba's sphere maps u = atan2(l.y, l.x) / 2 pi, v = acos(l.z) / pi in its own
+# frame l; wavetrace's spheres map u = 0.5 + atan2(n.z, n.x) / 2 pi,
+# v = acos(n.y) / pi. With l = (-n.x, n.z, n.y) (a rotation: this matrix) Mitsuba's
+# v is wavetrace's and Mitsuba's u is 1 - wavetrace's u, which image textures on
+# spheres undo with to_uv (SPHERE_TO_UV).
+SPHERE_FRAME = [[-1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+SPHERE_TO_UV = [[-1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+
+
+# --------------------------------------------------------------------------
+# Notes
+# --------------------------------------------------------------------------
+
+class Notes:
+    """The list of 'could not map' notes, each once, with how often it applied."""
+
+    def __init__(self):
+        self._counts = {}
+
+    def add(self, text):
+        self._counts[text] = self._counts.get(text, 0) + 1
+
+    def list(self):
+        return [t if n == 1 else "%s (%d times)" % (t, n) for t, n in self._counts.items()]
+
+    def __contains__(self, fragment):
+        return any(fragment in t for t in self._counts)
+
+    def __len__(self):
+        return len(self._counts)
+
+
+# --------------------------------------------------------------------------
+# Files the conversion writes (mesh parts, skies)
+# --------------------------------------------------------------------------
+
+def cache_dir():
+    d = os.environ.get("WAVETRACE_PEER_CACHE") or os.path.join(tempfile.gettempdir(), "wavetrace-mitsuba-peer")
+    os.makedirs(d, exist_ok=True)
+    return d
+
+
+def _source_key(path, *extra):
+    st = os.stat(path)
+    h = hashlib.sha1()
+    h.update(repr((os.path.abspath(path), st.st_size, st.st_mtime_ns, CONVERTER_VERSION) + extra).encode())
+    return h.hexdigest()[:16]
+
+
+def _write_atomic(path, data):
+    tmp = "%s.%d.tmp" % (path, os.getpid())
+    with open(tmp, "wb") as f:
+        f.write(data)
+    os.replace(tmp, path)
+
+
+def _le(arr):
+    if sys.byteorder != "little":
+        arr = array.array(arr.typecode, arr)
+        arr.byteswap()
+    return arr.tobytes()
+
+
+def write_pfm(path, width, height, rgb_rows):
+    """rgb_rows: `height` rows, top first, each `width` * 3 floats. PFM stores the
+    bottom row first."""
+    body = array.array("f")
+    for row in reversed(rgb_rows):
+        body.extend(row)
+    _write_atomic(path, b"PF\n%d %d\n-1\n" % (width, height) + _le(body))
+
+
+def write_ply(path, positions, normals, uvs, indices):
+    """Binary PLY: float x y z [nx ny nz] [u v] per vertex, triangles as lists with
+    a uint count. positions/normals/uvs/indices: flat arrays ('f', 'f', 'f', 'I')."""
+    n = len(positions) // 3
+    t = len(indices) // 3
+    stride = 3 + (3 if normals is not None else 0) + (2 if uvs is not None else 0)
+    verts = array.array("f", bytes(4 * stride * n))
+    for k in range(3):
+        verts[k::stride] = positions[k::3]
+    o = 3
+    if normals is not None:
+        for k in range(3):
+            verts[o + k::stride] = normals[k::3]
+        o += 3
+    if uvs is not None:
+        for k in range(2):
+            verts[o + k::stride] = uvs[k::2]
+    faces = array.array("I", bytes(16 * t))
+    faces[0::4] = array.array("I", [3]) * t
+    for k in range(3):
+        faces[1 + k::4] = indices[k::3]
+    head = ["ply", "format binary_little_endian 1.0", "element vertex %d" % n,
+            "property float x", "property float y", "property float z"]
+    if normals is not None:
+        head += ["property float nx", "property float ny", "property float nz"]
+    if uvs is not None:
+        head += ["property float u", "property float v"]
+    head += ["element face %d" % t, "property list uint uint vertex_indices", "end_header", ""]
+    _write_atomic(path, "\n".join(head).encode("ascii") + _le(verts) + _le(faces))
+
+
+# --------------------------------------------------------------------------
+# Mesh files: OBJ (+ MTL) and glTF, read as wavetrace reads them
+# --------------------------------------------------------------------------
+
+class MeshPart:
+    """Triangles of one material of a mesh file. kind 'obj': `file` can be given
+    to Mitsuba's obj plugin; 'ply': written by the converter. `material` is the
+    file's material as a wavetrace material dict (named '<mesh>/<name>')."""
+
+    def __init__(self, kind, file, material, has_normals, bounds, area_of=None):
+        self.kind, self.file, self.material = kind, file, material
+        self.has_normals = has_normals
+        self.bounds = bounds          # (lo, hi) in the file's coordinates
+        self.area_of = area_of        # function(matrix) -> world area (for emitters)
+
+
+def _triangle_area(a, b, c):
+    u = [b[i] - a[i] for i in range(3)]
+    v = [c[i] - a[i] for i in range(3)]
+    x = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+    return 0.5 * math.sqrt(sum(k * k for k in x))
+
+
+def _area_function(positions, indices):
+    """World area of the triangles under a transform (only for emitters: small)."""
+    def area(m):
+        total = 0.0
+        for t in range(0, len(indices), 3):
+            pts = [mat_point(m, positions[3 * indices[t + k]:3 * indices[t + k] + 3]) for k in range(3)]
+            total += _triangle_area(*pts)
+        return total
+    return area
+
+
+def _bounds(positions):
+    if not positions:
+        return ([0.0] * 3, [0.0] * 3)
+    return ([min(positions[k::3]) for k in range(3)], [max(positions[k::3]) for k in range(3)])
+
+
+def read_mtl(path, mesh_name, materials, notes):
+    """Adds the file's materials, mapped to wavetrace kinds (docs/scene-format.md)."""
+    folder = os.path.dirname(path)
+    cur = None
+    raw = {}
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            tok = line.split("#", 1)[0].split()
+            if not tok:
+                continue
+            if tok[0] == "newmtl":
+                cur = " ".join(tok[1:])
+                raw[cur] = {}
+            elif cur is not None and tok[0] in ("Kd", "Ks", "Ke"):
+                raw[cur][tok[0]] = [float(x) for x in tok[1:4]]
+            elif cur is not None and tok[0] in ("Ns", "Ni", "d"):
+                raw[cur][tok[0]] = float(tok[1])
+            elif cur is not None and tok[0] == "map_Kd":
+                raw[cur]["map_Kd"] = os.path.join(folder, tok[-1])
+    for name, r in raw.items():
+        kd, ks, ke = r.get("Kd", [0, 0, 0]), r.get("Ks", [0, 0, 0]), r.get("Ke", [0, 0, 0])
+        ni = r.get("Ni", 1.0)
+        ior = ni if ni > 1.0 else 1.5
+        full = "%s/%s" % (mesh_name, name)
+        if any(ke):
+            m = {"type": "emissive", "emission": ke}
+        elif r.get("d", 1.0) < 1.0:
+            m = {"type": "dielectric", "ior": ior}
+        elif any(ks) and not any(kd):
+            m = {"type": "metal", "albedo": ks, "fuzz": min(1.0, math.sqrt(2.0 / (r.get("Ns", 0.0) + 2.0)))}
+        elif any(ks):
+            m = {"type": "coated", "albedo": kd, "ior": ior}
+        else:
+            m = {"type": "lambertian", "albedo": kd}
+        if "map_Kd" in r and m["type"] in ("lambertian", "metal", "coated"):
+            m["__image__"] = {"file": r["map_Kd"], "colorspace": "srgb"}
+        m["name"] = full
+        materials[name] = m
+
+
+def read_obj(path, mesh_name, notes):
+    """Returns the mesh's parts, one per material. A file of one material is
+    handed to Mitsuba as it is; otherwise each material's faces go to an OBJ
+    file of their own in the cache folder."""
+    folder = os.path.dirname(path)
+    v, vt, vn = [], [], []
+    groups = {}       # material -> list of faces (lists of (vi, ti, ni), 0-based, -1: none)
+    order = []
+    materials = {}
+    current = None
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            tok = line.split("#", 1)[0].split()
+            if not tok:
+                continue
+            key = tok[0]
+            if key == "v":
+                v.append(tok[1:4])
+            elif key == "vt":
+                vt.append(tok[1:3])
+            elif key == "vn":
+                vn.append(tok[1:4])
+            elif key == "f":
+                face = []
+                for c in tok[1:]:
+                    parts = c.split("/")
+                    idx = []
+                    for i, count in zip(range(3), (len(v), len(vt), len(vn))):
+                        if i < len(parts) and parts[i]:
+                            k = int(parts[i])
+                            idx.append(k - 1 if k > 0 else count + k)
+                        else:
+                            idx.append(-1)
+                    face.append(tuple(idx))
+                if current not in groups:
+                    groups[current] = []
+                    order.append(current)
+                groups[current].append(face)
+            elif key == "usemtl":
+                current = " ".join(tok[1:])
+            elif key == "mtllib":
+                mtl = os.path.join(folder, " ".join(tok[1:]))
+                if not os.path.exists(mtl):
+                    raise ConversionError("%s: MTL file %s not found" % (path, mtl))
+                read_mtl(mtl, mesh_name, materials, notes)
+    if not groups:
+        raise ConversionError("%s: no faces" % path)
+    positions_all = [float(x) for p in v for x in p]
+    every_normal = all(all(i[2] >= 0 for i in face) for faces in groups.values() for face in faces)
+    parts = []
+    single = len(order) == 1
+    for name in order:
+        faces = groups[name]
+        if name is None:
+            material = {"type": "lambertian", "albedo": [1, 1, 1], "name": "%s/default" % mesh_name}
+        elif name in materials:
+            material = materials[name]
+        else:
+            raise ConversionError("%s: usemtl %s names no material of its MTL file" % (path, name))
+        used = sorted({i[0] for face in faces for i in face})
+        pos = [float(x) for i in used for x in v[i]]
+        tris = []
+        remap = {o: k for k, o in enumerate(used)}
+        for face in faces:
+            for k in range(1, len(face) - 1):
+                tris += [remap[face[0][0]], remap[face[k][0]], remap[face[k + 1][0]]]
+        area_of = _area_function(pos, tris) if material["type"] == "emissive" else None
+        if single:
+            parts.append(MeshPart("obj", path, material, every_normal, _bounds(positions_all), area_of))
+            continue
+        out = os.path.join(cache_dir(), "%s-%s.obj" % (os.path.splitext(os.path.basename(path))[0],
+                                                       _source_key(path, name)))
+        if not os.path.exists(out):
+            vmap, tmap, nmap = {}, {}, {}
+            lines = ["# %s, material %s: written by bench/mitsuba_peer.py" % (os.path.basename(path), name)]
+            body = []
+            for face in faces:
+                refs = []
+                for (a, b, c) in face:
+                    if a not in vmap:
+                        vmap[a] = len(vmap) + 1
+                        lines.append("v " + " ".join(v[a]))
+                    r = str(vmap[a])
+                    if b >= 0:
+                        if b not in tmap:
+                            tmap[b] = len(tmap) + 1
+                            lines.append("vt " + " ".join(vt[b]))
+                        r += "/" + str(tmap[b])
+                    if c >= 0 and every_normal:
+                        if c not in nmap:
+                            nmap[c] = len(nmap) + 1
+                            lines.append("vn " + " ".join(vn[c]))
+                        r += ("/" if b >= 0 else "//") + str(nmap[c])
+                    refs.append(r)
+                body.append("f " + " ".join(refs))
+            _write_atomic(out, ("\n".join(lines + body) + "\n").encode())
+        parts.append(MeshPart("obj", out, material, every_normal, _bounds(pos), area_of))
+    return parts
+
+
+GLTF_COMPONENTS = {5120: ("b", 1), 5121: ("B", 1), 5122: ("h", 2), 5123: ("H", 2), 5125: ("I", 4), 5126: ("f", 4)}
+GLTF_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+
+def _gltf_load(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] == b"glTF":
+        _, _, length = struct.unpack_from("<III", data, 0)
+        jlen, _ = struct.unpack_from("<II", data, 12)
+        doc = json.loads(data[20:20 + jlen].decode("utf-8"))
+        pos = 20 + jlen
+        glb_bin = None
+        if pos + 8 <= len(data):
+            blen, _ = struct.unpack_from("<II", data, pos)
+            glb_bin = data[pos + 8:pos + 8 + blen]
+    else:
+        doc = json.loads(data.decode("utf-8"))
+        glb_bin = None
+    buffers = []
+    for i, b in enumerate(doc.get("buffers", [])):
+        uri = b.get("uri")
+        if uri is None:
+            buffers.append(glb_bin)
+        elif uri.startswith("data:"):
+            buffers.append(base64.b64decode(uri.split(",", 1)[1]))
+        else:
+            with open(os.path.join(os.path.dirname(path), uri), "rb") as f:
+                buffers.append(f.read())
+    return doc, buffers
+
+
+def _gltf_accessor(doc, buffers, index):
+    a = doc["accessors"][index]
+    code, size = GLTF_COMPONENTS[a["componentType"]]
+    width = GLTF_WIDTH[a["type"]]
+    count = a["count"]
+    out = array.array(code)
+    if "bufferView" not in a:
+        return array.array("f", bytes(4 * width * count)) if code == "f" else array.array(code, [0] * (width * count))
+    view = doc["bufferViews"][a["bufferView"]]
+    buf = buffers[view["buffer"]]
+    start = view.get("byteOffset", 0) + a.get("byteOffset", 0)
+    stride = view.get("byteStride", 0) or width * size
+    if stride == width * size:
+        out.frombytes(buf[start:start + count * stride])
+    else:
+        for k in range(count):
+            out.frombytes(buf[start + k * stride:start + k * stride + width * size])
+    if sys.byteorder != "little":
+        out.byteswap()
+    if a.get("normalized") and code != "f":
+        scale = {"b": 127.0, "B": 255.0, "h": 32767.0, "H": 65535.0}[code]
+        out = array.array("f", [max(x / scale, -1.0) for x in out])
+    return out
+
+
+def _quat_matrix(q):
+    x, y, z, w = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w), 0],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w), 0],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y), 0],
+            [0, 0, 0, 1]]
+
+
+def _node_matrix(node):
+    if "matrix" in node:
+        v = node["matrix"]  # column-major
+        return [[float(v[4 * c + r]) for c in range(4)] for r in range(4)]
+    m = mat_identity()
+    if "translation" in node:
+        m = mat_mul(m, mat_translate(node["translation"]))
+    if "rotation" in node:
+        m = mat_mul(m, _quat_matrix(node["rotation"]))
+    if "scale" in node:
+        m = mat_mul(m, mat_scale(node["scale"]))
+    return m
+
+
+def _gltf_material(doc, index, mesh_name, folder, notes):
+    if index is None:
+        return {"type": "metal", "albedo": [1, 1, 1], "fuzz": 1.0, "name": "%s/default" % mesh_name}
+    g = doc["materials"][index]
+    name = "%s/%s" % (mesh_name, g.get("name", "material %d" % index))
+    pbr = g.get("pbrMetallicRoughness", {})
+    base = list(pbr.get("baseColorFactor", [1, 1, 1, 1]))[:3]
+    metallic = pbr.get("metallicFactor", 1.0)
+    rough = pbr.get("roughnessFactor", 1.0)
+    emissive = g.get("emissiveFactor", [0, 0, 0])
+    if any(emissive):
+        m = {"type": "emissive", "emission": list(emissive)}
+    elif metallic >= 0.5:
+        m = {"type": "metal", "albedo": base, "fuzz": rough}
+    elif rough < 0.5:
+        m = {"type": "coated", "albedo": base, "ior": 1.5}
+    else:
+        m = {"type": "lambertian", "albedo": base}
+    tex = pbr.get("baseColorTexture")
+    if tex is not None and m["type"] in ("lambertian", "metal", "coated"):
+        image = doc["images"][doc["textures"][tex["index"]]["source"]]
+        if "uri" not in image or image["uri"].startswith("data:"):
+            raise ConversionError("%s: embedded glTF images are not supported (as in wavetrace)" % mesh_name)
+        m["__image__"] = {"file": os.path.join(folder, image["uri"]), "colorspace": "srgb"}
+    m["name"] = name
+    return m
+
+
+def read_gltf(path, mesh_name, notes):
+    """glTF / GLB: Mitsuba 3 reads neither, so each primitive (with the node
+    transforms applied, as wavetrace applies them) is written to a binary PLY."""
+    notes.add("glTF/GLB meshes: Mitsuba 3 has no glTF loader; each primitive was written to a PLY file "
+              "(node transforms applied, as wavetrace does)")
+    doc, buffers = _gltf_load(path)
+    folder = os.path.dirname(path)
+    scenes = doc.get("scenes")
+    if scenes:
+        roots = scenes[doc.get("scene", 0)].get("nodes", [])
+        todo = [(r, mat_identity()) for r in roots]
+    else:
+        todo = [(i, mat_identity()) for i, n in enumerate(doc.get("nodes", [])) if "mesh" in n]
+        if not todo:
+            todo = None
+    placed = []   # (mesh index, matrix)
+    if todo is None:
+        placed = [(i, mat_identity()) for i in range(len(doc.get("meshes", [])))]
+    else:
+        while todo:
+            i, parent = todo.pop(0)
+            node = doc["nodes"][i]
+            m = mat_mul(parent, _node_matrix(node))
+            if "mesh" in node:
+                placed.append((node["mesh"], m))
+            todo += [(c, m) for c in node.get("children", [])]
+    prims = [(mi_, m, p) for mi_, m in placed for p in doc["meshes"][mi_]["primitives"]]
+    every_normal = all("NORMAL" in p["attributes"] for _, _, p in prims)
+    every_uv = all("TEXCOORD_0" in p["attributes"] for _, _, p in prims)
+    parts = []
+    for k, (mesh_index, m, prim) in enumerate(prims):
+        if prim.get("mode", 4) != 4:
+            raise ConversionError("%s: a primitive that is not TRIANGLES" % path)
+        material = _gltf_material(doc, prim.get("material"), mesh_name, folder, notes)
+        out = os.path.join(cache_dir(), "%s-%s.ply" % (os.path.splitext(os.path.basename(path))[0],
+                                                       _source_key(path, k)))
+        pos = _gltf_accessor(doc, buffers, prim["attributes"]["POSITION"])
+        if "indices" in prim:
+            ind = array.array("I", _gltf_accessor(doc, buffers, prim["indices"]))
+        else:
+            ind = array.array("I", range(len(pos) // 3))
+        if not is_identity(m):
+            p2 = array.array("f", bytes(len(pos) * 4))
+            for i in range(0, len(pos), 3):
+                p2[i:i + 3] = array.array("f", mat_point(m, pos[i:i + 3]))
+            pos = p2
+        area_of = _area_function(pos, ind) if material["type"] == "emissive" else None
+        if not os.path.exists(out):
+            nrm = uv = None
+            if every_normal:
+                nrm = _gltf_accessor(doc, buffers, prim["attributes"]["NORMAL"])
+                if not is_identity(m):
+                    nm = mat_inverse_affine(m)   # normals: the inverse transpose
+                    n2 = array.array("f", bytes(len(nrm) * 4))
+                    for i in range(0, len(nrm), 3):
+                        x, y, z = nrm[i:i + 3]
+                        w = [nm[0][r] * x + nm[1][r] * y + nm[2][r] * z for r in range(3)]
+                        ln = math.sqrt(sum(c * c for c in w)) or 1.0
+                        n2[i:i + 3] = array.array("f", [c / ln for c in w])
+                    nrm = n2
+            if every_uv:
+                # glTF's v = 0 is the image's top row, where Mitsuba's bitmap has
+                # v = 0 as well (wavetrace reads 1 - v into OBJ's convention and
+                # flips back when it samples): written as it is.
+                uv = _gltf_accessor(doc, buffers, prim["attributes"]["TEXCOORD_0"])
+            write_ply(out, pos, nrm, uv, ind)
+        parts.append(MeshPart("ply", out, material, every_normal, _bounds(pos), area_of))
+    if not parts:
+        raise ConversionError("%s: no triangles" % path)
+    return parts
+
+
+def read_mesh(path, mesh_name, notes):
+    ext = os.path.splitext(path)[1].lower()
+    if not os.path.exists(path):
+        raise ConversionError("mesh file %s not found" % path)
+    if ext == ".obj":
+        return read_obj(path, mesh_name, notes)
+    if ext in (".gltf", ".glb"):
+        return read_gltf(path, mesh_name, notes)
+    raise ConversionError("%s: unknown mesh extension" % path)
+
+
+# --------------------------------------------------------------------------
+# The scene
+# --------------------------------------------------------------------------
+
+def _rgb(c):
+    return {"type": "rgb", "value": [float(x) for x in c]}
+
+
+def _is_white(c):
+    return all(float(x) == 1.0 for x in c)
+
+
+def _mean3(c):
+    return (float(c[0]) + float(c[1]) + float(c[2])) / 3.0
+
+
+class Converter:
+    """Builds the Mitsuba dict of one wavetrace scene file."""
+
+    def __init__(self, scene_path, width=None, height=None, spp=None, depth=None, roulette_depth=None,
+                 seed=None, nee=None, instancing=False, sky_sampling="auto", python_plugins=True, doc=None):
+        self.path = scene_path
+        self.folder = os.path.dirname(os.path.abspath(scene_path))
+        if doc is None:
+            with open(scene_path, encoding="utf-8") as f:
+                doc = json.load(f)
+        self.doc = doc
+        r = doc.get("render", {})
+
+        def pick(value, key, default):
+            return value if value is not None else r.get(key, default)
+
+        self.width = int(pick(width, "width", 640))
+        self.height = int(pick(height, "height", 360))
+        self.spp = int(pick(spp, "spp", 16))        # wavetrace's defaults (RenderDefaults)
+        self.depth = int(pick(depth, "depth", 10))
+        self.roulette_depth = int(pick(roulette_depth, "roulette_depth", 5))
+        self.seed = int(pick(seed, "seed", 1))
+        self.nee = int(pick(nee, "nee", 1))
+        self.instancing = instancing
+        self.allow_python = python_plugins
+        if sky_sampling not in ("auto", "always"):
+            raise ConversionError("sky_sampling must be auto or always")
+        self.sky_sampling = sky_sampling
+        self.notes = Notes()
+        self.out = {"type": "scene"}
+        self.textures = {t["name"]: t for t in doc.get("textures", [])}
+        self.materials = {m["name"]: m for m in doc.get("materials", [])}
+        self.python_plugins = set()
+        self.emitters = []      # (dict, wavetrace samples it, power)
+        self.bounds = None      # scene bounding box (lo, hi)
+        self._bsdf_ids = {}
+        self._counter = 0
+
+    # -- helpers ---------------------------------------------------------
+    def file(self, rel):
+        return os.path.normpath(os.path.join(self.folder, rel))
+
+    def _name(self, prefix):
+        self._counter += 1
+        return "%s_%05d" % (prefix, self._counter)
+
+    def _grow(self, lo, hi):
+        if self.bounds is None:
+            self.bounds = (list(lo), list(hi))
+        else:
+            self.bounds = ([min(a, b) for a, b in zip(self.bounds[0], lo)],
+                           [max(a, b) for a, b in zip(self.bounds[1], hi)])
+
+    # -- camera, film, sampler, integrator -----------------------------------
+    def camera(self):
+        cam = self.doc["camera"]
+        look_from = [float(x) for x in cam["look_from"]]
+        look_at = [float(x) for x in cam["look_at"]]
+        up = [float(x) for x in cam.get("up", [0, 1, 0])]
+        vfov = float(cam.get("vfov", 40))
+        aperture = float(cam.get("aperture", 0))
+        focus = cam.get("focus_distance")
+        if focus is None or float(focus) <= 0:
+            focus = math.sqrt(sum((a - b) ** 2 for a, b in zip(look_from, look_at)))
+        sensor = {
+            "type": "perspective",
+            "fov": vfov,
+            "fov_axis": "y",
+            "near_clip": 1e-4 * float(focus),
+            "far_clip": 1e7,
+            "to_world": transform(look_at_matrix(look_from, look_at, up)),
+            "film": {
+                "type": "hdrfilm",
+                "width": self.width,
+                "height": self.height,
+                "pixel_format": "rgb",
+                "component_format": "float32",
+                "rfilter": {"type": "box"},
+            },
+            "sampler": {"type": "independent", "sample_count": self.spp, "seed": self.seed},
+        }
+        if aperture > 0:
+            sensor["type"] = "thinlens"
+            sensor["aperture_radius"] = 0.5 * aperture
+            sensor["focus_distance"] = float(focus)
+        return sensor
+
+    def integrator(self):
+        # Both count the camera ray: wavetrace traces at most `depth` rays a path,
+        # Mitsuba's max_depth is "the longest path depth" (1: only directly visible
+        # emitters, 2: direct lighting). Roulette: wavetrace plays it after the
+        # scatter at hit number roulette_depth (1-based) and on; Mitsuba's path
+        # tracer when its depth counter (hits so far) >= rr_depth.
+        return {"type": "path", "max_depth": self.depth, "rr_depth": self.roulette_depth, "hide_emitters": False}
+
+    # -- textures and materials ---------------------------------------------
+    def texture(self, name, albedo, on_sphere, to_object):
+        """The reflectance: albedo times the named texture. to_object: the
+        shape's world -> object matrix (for checker)."""
+        t = self.textures.get(name)
+        if t is None:
+            raise ConversionError("unknown texture %s" % name)
+        return self._texture(t, albedo, on_sphere, to_object)
+
+    def _texture(self, t, albedo, on_sphere, to_object):
+        kind = t["type"]
+        if kind == "checker":
+            size = float(t["size"])
+            even = [float(a) * float(b) for a, b in zip(albedo, t["even"])]
+            odd = [float(a) * float(b) for a, b in zip(albedo, t["odd"])]
+            if not self.allow_python:
+                mean = [0.5 * (a + b) for a, b in zip(even, odd)]
+                self.notes.add("checker texture '%s': without Python plugins, its mean colour %s"
+                               % (t["name"], [round(x, 4) for x in mean]))
+                return _rgb(mean)
+            # Mitsuba's checkerboard is a function of the surface's UVs (a sphere's
+            # are its angles), wavetrace's of the object-space x and z: a texture
+            # written in Python evaluates wavetrace's pattern exactly.
+            self.python_plugins.add("wt_checker")
+            # The object-space point's x and z (rows 0 and 2 of to_object) are all it reads.
+            d = {"type": "wt_checker", "size": size}
+            for row, label in ((0, "x"), (2, "z")):
+                for k in range(4):
+                    d["o%s%d" % (label, k)] = float(to_object[row][k])
+            for label, c in (("even", even), ("odd", odd)):
+                for ch, x in zip("rgb", c):
+                    d["%s_%s" % (label, ch)] = x
+            return d
+        if kind == "noise":
+            hi, lo = t["high"], t["low"]
+            mean = [float(a) * 0.5 * (float(h) + float(l)) for a, h, l in zip(albedo, hi, lo)]
+            self.notes.add("noise texture '%s': no Mitsuba counterpart; its mean colour "
+                           "(high + low) / 2 x albedo = %s is used" % (t["name"], [round(x, 4) for x in mean]))
+            return _rgb(mean)
+        if kind == "image":
+            return self._image(self.file(t["file"]), t.get("colorspace", "srgb"), albedo, on_sphere)
+        raise ConversionError("unknown texture type %s" % kind)
+
+    def _image(self, path, colorspace, albedo, on_sphere):
+        d = {"type": "bitmap", "filename": path, "raw": colorspace == "linear",
+             "filter_type": "bilinear", "wrap_mode": "repeat"}
+        self.notes.add("image textures: Mitsuba's bitmap wraps v as well (wavetrace clamps it): "
+                       "differs within half a texel of the top and bottom rows")
+        if on_sphere:
+            d["to_uv"] = transform(SPHERE_TO_UV)
+        if not _is_white(albedo) and not self.allow_python:
+            self.notes.add("image texture %s: without Python plugins, the albedo %s it is multiplied by "
+                           "is dropped" % (os.path.basename(path), list(albedo)))
+        elif not _is_white(albedo):
+            self.python_plugins.add("wt_scale")
+            return {"type": "wt_scale", "texture": d, "r": float(albedo[0]), "g": float(albedo[1]),
+                    "b": float(albedo[2])}
+        return d
+
+    def reflectance(self, m, on_sphere, to_object):
+        albedo = m.get("albedo", [1, 1, 1])
+        if "texture" in m:
+            return self.texture(m["texture"], albedo, on_sphere, to_object)
+        if "__image__" in m:
+            return self._image(m["__image__"]["file"], m["__image__"]["colorspace"], albedo, on_sphere)
+        return _rgb(albedo)
+
+    def object_space(self, m):
+        """Whether the material's texture is a function of the object-space point."""
+        t = self.textures.get(m.get("texture", ""))
+        return t is not None and t["type"] == "checker"
+
+    def bsdf(self, m, on_sphere, to_object):
+        """The BSDF dict of a wavetrace material (no id)."""
+        kind = m["type"]
+        if kind == "lambertian":
+            b = {"type": "diffuse", "reflectance": self.reflectance(m, on_sphere, to_object)}
+        elif kind == "metal":
+            fuzz = float(m.get("fuzz", 0))
+            refl = self.reflectance(m, on_sphere, to_object)
+            if fuzz == 0:
+                b = {"type": "conductor", "material": "none", "specular_reflectance": refl}
+            else:
+                b = {"type": "roughconductor", "material": "none", "distribution": "beckmann",
+                     "alpha": fuzz * FUZZ_TO_ALPHA, "specular_reflectance": refl}
+                self.notes.add("metal fuzz -> roughconductor (Beckmann) alpha = fuzz / sqrt(6) (equal mean-square "
+                               "half-vector slope at normal incidence); the lobe shapes differ, and Mitsuba "
+                               "adds Smith masking (wavetrace absorbs only what the fuzz sends below the surface)")
+        elif kind == "dielectric":
+            b = {"type": "dielectric", "int_ior": float(m["ior"]), "ext_ior": 1.0}
+            tint = m.get("albedo", [1, 1, 1])
+            if not _is_white(tint):
+                b["specular_reflectance"] = _rgb(tint)
+                b["specular_transmittance"] = _rgb(tint)
+            self.notes.add("dielectric: Mitsuba uses the exact Fresnel equations (wavetrace: Schlick's "
+                           "approximation) and scales radiance by 1/eta^2 on refraction (cancels on leaving)")
+        elif kind == "coated":
+            b = {"type": "plastic", "diffuse_reflectance": self.reflectance(m, on_sphere, to_object),
+                 "int_ior": float(m["ior"]), "ext_ior": 1.0, "nonlinear": False}
+            self.notes.add("coated -> plastic: Mitsuba's coat has exact Fresnel and internal reflections "
+                           "between coat and base (wavetrace: a Schlick-weighted choice of mirror or Lambertian)")
+        elif kind == "emissive":
+            # The path ends at an emitter in wavetrace: a black mirror ends it
+            # here too (zero throughput, and no light sample at a delta BSDF).
+            b = {"type": "conductor", "material": "none", "specular_reflectance": _rgb([0, 0, 0])}
+        else:
+            raise ConversionError("unknown material type %s" % kind)
+        if not on_sphere and kind in ("lambertian", "metal", "coated"):
+            # wavetrace shades either side of a triangle (it turns the normal to the
+            # ray); Mitsuba's BSDFs are one-sided unless wrapped.
+            b = {"type": "twosided", "bsdf": b}
+        return b
+
+    def bsdf_ref(self, m, on_sphere, to_object):
+        """A shared BSDF where one can be shared, else an inline one."""
+        if self.object_space(m):
+            return self.bsdf(m, on_sphere, to_object)
+        key = (m["name"], on_sphere)
+        if key not in self._bsdf_ids:
+            ident = self._name("bsdf")
+            d = self.bsdf(m, on_sphere, to_object)
+            self.out[ident] = d
+            self._bsdf_ids[key] = ident
+        return {"type": "ref", "id": self._bsdf_ids[key]}
+
+    def emitter_for(self, m, area):
+        """The area emitter of an emissive material (None for other kinds)."""
+        if m["type"] != "emissive":
+            return None
+        e = [float(x) for x in m["emission"]]
+        if not any(e):
+            return None
+        d = {"type": "area", "radiance": _rgb(e)}
+        self.emitters.append((d, True, _mean3(e) * area))
+        return d
+
+    # -- shapes ---------------------------------------------------------------
+    def spheres(self):
+        for s in self.doc.get("spheres", []):
+            m = self.materials[s["material"]]
+            c = [float(x) for x in s["center"]]
+            r = float(s["radius"])
+            to_world = mat_mul(mat_mul(mat_translate(c), SPHERE_FRAME), mat_scale(r))
+            shape = {"type": "sphere", "to_world": transform(to_world),
+                     "bsdf": self.bsdf_ref(m, True, mat_translate([-x for x in c]))}
+            em = self.emitter_for(m, 4.0 * math.pi * r * r)
+            if em is not None:
+                shape["emitter"] = em
+            self.out[self._name("sphere")] = shape
+            self._grow([x - r for x in c], [x + r for x in c])
+
+    @staticmethod
+    def _part_shape(part, to_world):
+        shape = {"type": part.kind, "filename": part.file}
+        if not part.has_normals:
+            # wavetrace shades with the geometric normal where the mesh has no
+            # vertex normals; Mitsuba would compute smooth ones.
+            shape["face_normals"] = True
+        if to_world is not None:
+            shape["to_world"] = transform(to_world)
+        return shape
+
+    def meshes(self):
+        meshes = {}
+        for mesh in self.doc.get("meshes", []):
+            parts = read_mesh(self.file(mesh["file"]), mesh["name"], self.notes)
+            meshes[mesh["name"]] = (mesh, parts)
+        placements = []
+        for inst in self.doc.get("instances", []):
+            mesh, parts = meshes[inst["mesh"]]
+            matrix = instance_matrix(inst)
+            override = inst.get("material", mesh.get("material"))
+            mats = [self.materials[override] if override is not None else p.material for p in parts]
+            placements.append((inst, mesh, parts, matrix, mats))
+            for p in parts:
+                lo, hi = p.bounds
+                corners = [[(lo, hi)[(k >> i) & 1][i] for i in range(3)] for k in range(8)]
+                world = [mat_point(matrix, c) for c in corners]
+                self._grow([min(w[i] for w in world) for i in range(3)], [max(w[i] for w in world) for i in range(3)])
+        if any(m["type"] == "emissive" for *_, mats in placements for m in mats):
+            self.notes.add("emissive triangles emit on their front side only in Mitsuba (wavetrace: both sides)")
+        # Placements that can share one Mitsuba shapegroup: same mesh, same
+        # materials, nothing that depends on the placement (object-space
+        # textures, emitters: Mitsuba instances cannot carry area emitters).
+        counts = {}
+        for inst in self.doc.get("instances", []):
+            counts[inst["mesh"]] = counts.get(inst["mesh"], 0) + 1
+        if not self.instancing and any(n > 1 for n in counts.values()):
+            self.notes.add("meshes placed more than once: each placement is a Mitsuba shape of its own, holding "
+                           "its own transformed copy of the triangles (wavetrace stores each mesh once). "
+                           "Mitsuba 3.7.1's shapegroup instancing (--instancing) costs host time on every render "
+                           "that grows faster than the instance count (terrain, 400 instances: about 100 s a render "
+                           "on the LLVM backend, against 0.1 s flattened)")
+        groups = {}
+        for k, (inst, mesh, parts, matrix, mats) in enumerate(placements):
+            shareable = self.instancing and not any(self.object_space(m) or m["type"] == "emissive" for m in mats)
+            key = (mesh["name"], tuple(m["name"] for m in mats)) if shareable else ("#", k)
+            groups.setdefault(key, []).append(k)
+        for key, members in groups.items():
+            if len(members) > 1:
+                _, mesh, parts, _, mats = placements[members[0]]
+                gid = self._name("group")
+                group = {"type": "shapegroup"}
+                for p, m in zip(parts, mats):
+                    shape = self._part_shape(p, None)
+                    shape["bsdf"] = self.bsdf_ref(m, False, mat_identity())
+                    group[self._name("part")] = shape
+                self.out[gid] = group
+                for k in members:
+                    self.out[self._name("instance")] = {"type": "instance", "shapegroup": {"type": "ref", "id": gid},
+                                                        "to_world": transform(placements[k][3])}
+                continue
+            inst, mesh, parts, matrix, mats = placements[members[0]]
+            for p, m in zip(parts, mats):
+                shape = self._part_shape(p, None if is_identity(matrix) else matrix)
+                shape["bsdf"] = self.bsdf_ref(m, False, mat_inverse_affine(matrix))
+                if m["type"] == "emissive":
+                    em = self.emitter_for(m, p.area_of(matrix) if p.area_of else 0.0)
+                    if em is not None:
+                        shape["emitter"] = em
+                self.out[self._name("mesh")] = shape
+
+    # -- sky ----------------------------------------------------------------
+    def sky(self):
+        sky = self.doc.get("sky", {"type": "gradient"})
+        kind = sky.get("type", "gradient")
+        lo, hi = self.bounds if self.bounds else ([0.0] * 3, [0.0] * 3)
+        radius = 0.5 * math.sqrt(sum((b - a) ** 2 for a, b in zip(lo, hi)))
+        sphere_area = 4.0 * math.pi * radius * radius
+        if kind == "uniform":
+            rad = [float(x) for x in sky["radiance"]]
+            if not any(rad):
+                return  # black: no emitter in either renderer
+            d = {"type": "constant", "radiance": _rgb(rad)}
+            self.emitters.append((d, True, _mean3(rad) * sphere_area))
+        elif kind == "gradient":
+            horizon = [float(x) for x in sky.get("horizon", [1, 1, 1])]
+            zenith = [float(x) for x in sky.get("zenith", [0.5, 0.7, 1.0])]
+            rows = []
+            for i in range(GRADIENT_SKY_ROWS):
+                theta = math.pi * i / (GRADIENT_SKY_ROWS - 1)
+                t = 0.5 * (math.cos(theta) + 1.0)
+                c = [(1 - t) * h + t * z for h, z in zip(horizon, zenith)]
+                rows.append(c * GRADIENT_SKY_COLUMNS)
+            key = hashlib.sha1(repr((horizon, zenith, GRADIENT_SKY_ROWS, GRADIENT_SKY_COLUMNS)).encode()).hexdigest()[:16]
+            path = os.path.join(cache_dir(), "gradient-sky-%s.pfm" % key)
+            if not os.path.exists(path):
+                write_pfm(path, GRADIENT_SKY_COLUMNS, GRADIENT_SKY_ROWS, rows)
+            d = {"type": "envmap", "filename": path}
+            # Interpolating t = (cos theta + 1) / 2 linearly between rows h apart
+            # errs by at most h^2 / 8 x max |t''| = h^2 / 16.
+            self.notes.add("gradient sky -> envmap of a %dx%d lat-long image, linear in theta between rows "
+                           "(wavetrace: linear in dir.y; at most %.1e of the colour difference apart)"
+                           % (GRADIENT_SKY_COLUMNS, GRADIENT_SKY_ROWS, (math.pi / (GRADIENT_SKY_ROWS - 1)) ** 2 / 16))
+            samples = self.sky_sampling == "always"
+            if not samples and (self.allow_python or any(s for _, s, _ in self.emitters)):
+                self.notes.add("gradient sky: not sampled as a light, as in wavetrace (envmap sampling_weight 0)")
+            self.emitters.append((d, samples, _mean3([(a + b) / 2 for a, b in zip(horizon, zenith)]) * sphere_area))
+        elif kind == "environment":
+            path = self.file(sky["file"])
+            mapping = sky.get("mapping", "latlong")
+            intensity = float(sky.get("intensity", 1.0))
+            rotation = float(sky.get("rotation", 0.0))
+            ext = os.path.splitext(path)[1].lower()
+            d = {"type": "envmap", "scale": intensity}
+            if mapping == "latlong" and ext in (".hdr", ".exr"):
+                d["filename"] = path
+            else:
+                # Read and (for angular / mirror ball) resampled into a lat-long
+                # image by load_scene, which has Mitsuba's image readers.
+                d["__envmap_image__"] = {"file": path, "mapping": mapping,
+                                         "srgb": ext not in (".hdr", ".exr") and sky.get("colorspace", "srgb") == "srgb"}
+                if mapping != "latlong":
+                    self.notes.add("environment mapping '%s': resampled to a %dx%d lat-long image when loaded "
+                                   "(bilinear, as wavetrace samples it)" % (mapping, 2 * RESAMPLED_SKY_ROWS,
+                                                                             RESAMPLED_SKY_ROWS))
+            # wavetrace turns the environment about +y by `rotation` (x toward -z)
+            # and looks up u = atan2(e.x, -e.z) / 2 pi, v = acos(e.y) / pi, the
+            # mapping of Mitsuba's envmap in its own frame: to_world is the same turn.
+            if rotation != 0:
+                d["to_world"] = transform(mat_rotate("y", rotation))
+            self.notes.add("environment image: Mitsuba's envmap puts row centres at v = i / (rows - 1) "
+                           "(wavetrace: (i + 0.5) / rows): up to half a texel apart toward the poles, none at "
+                           "the horizon")
+            # wavetrace's power: the mean radiance over the sphere (sin-weighted
+            # rows) x the bounding sphere's area; not known without reading the
+            # image, so the emitter keeps Mitsuba's default weight where others
+            # are sampled too (a pick probability; the estimate stays unbiased).
+            self.emitters.append((d, True, None))
+        else:
+            raise ConversionError("unknown sky type %s" % kind)
+
+    def emitter_weights(self):
+        """Which emitters light sampling picks, and how often: as wavetrace,
+        by power (mean emission x area); none where wavetrace samples none."""
+        sampled = [(d, p) for d, s, p in self.emitters if s and self.nee]
+        if len(self.emitters) > 1 or any(not s for _, s, _ in self.emitters) or not self.nee:
+            known = [p for _, p in sampled if p is not None]
+            default = (sum(known) / len(known)) if known else 1.0
+            for d, s, p in self.emitters:
+                d["sampling_weight"] = float((p if p is not None else default) if (s and self.nee) else 0.0)
+            if len(self.emitters) > 1 and any(p is None for _, p in sampled):
+                self.notes.add("environment sky's light-picking weight is the mean of the other emitters' "
+                               "(wavetrace weighs it by its power)")
+        if self.emitters and not sampled and not self.allow_python:
+            for d, _, _ in self.emitters:
+                d.pop("sampling_weight", None)
+            self.notes.add("without Python plugins every emitter is sampled as a light (Mitsuba's default), where "
+                           "wavetrace samples none: a light sample and shadow ray at every diffuse hit")
+        elif self.emitters and not sampled:
+            # Mitsuba 3.7 refuses a scene whose emitters all have weight 0: a
+            # null emitter takes every light sample and returns none.
+            self.python_plugins.add("wt_null")
+            self.out["null_emitter"] = {"type": "wt_null", "sampling_weight": 1.0}
+            if not self.nee:
+                self.notes.add("nee 0: every emitter has sampling_weight 0 (pure path tracing, as wavetrace --no-nee)")
+
+    # -- all ----------------------------------------------------------------
+    def convert(self):
+        self.out["integrator"] = self.integrator()
+        self.out["sensor"] = self.camera()
+        self.spheres()
+        self.meshes()
+        self.sky()
+        for d, _, _ in self.emitters:
+            if d["type"] in ("constant", "envmap"):
+                self.out["sky"] = d
+        self.emitter_weights()
+        if "spheres" not in self.doc and "instances" not in self.doc:
+            raise ConversionError("the scene has no spheres and no instances")
+        return self.out
+
+
+class Conversion:
+    def __init__(self, scene, notes, settings, python_plugins):
+        self.scene, self.notes, self.settings = scene, notes, settings
+        self.python_plugins = sorted(python_plugins)
+
+    def plugins(self):
+        """Every plugin type the dict names."""
+        found = set()
+
+        def walk(d):
+            if isinstance(d, dict):
+                if "type" in d and isinstance(d["type"], str) and d["type"] != "ref":
+                    found.add(d["type"])
+                for v in d.values():
+                    walk(v)
+        walk(self.scene)
+        return sorted(found)
+
+
+def convert(scene_path, **kw):
+    c = Converter(scene_path, **kw)
+    scene = c.convert()
+    settings = {"width": c.width, "height": c.height, "spp": c.spp, "depth": c.depth,
+                "roulette_depth": c.roulette_depth, "seed": c.seed, "nee": c.nee}
+    return Conversion(scene, c.notes.list(), settings, c.python_plugins)
+
+
+# --------------------------------------------------------------------------
+# Mitsuba: plugins written in Python, loading
+# --------------------------------------------------------------------------
+
+def register_python_plugins(mi, dr, names):
+    """Registers the Python plugins the dict names (they are traced into the
+    kernels like Mitsuba's own: no per-sample Python)."""
+    if "wt_checker" in names:
+        class Checker(mi.Texture):
+            """wavetrace's checker: squares of `size` in x and z of the object-space point."""
+
+            def __init__(self, props):
+                mi.Texture.__init__(self, props)
+                self.size = props.get("size")
+                self.ox = [props.get("ox%d" % k) for k in range(4)]
+                self.oz = [props.get("oz%d" % k) for k in range(4)]
+                self.even = mi.ScalarColor3f(props.get("even_r"), props.get("even_g"), props.get("even_b"))
+                self.odd = mi.ScalarColor3f(props.get("odd_r"), props.get("odd_g"), props.get("odd_b"))
+
+            def eval(self, si, active=True):
+                p = si.p
+                x = self.ox[0] * p.x + self.ox[1] * p.y + self.ox[2] * p.z + self.ox[3]
+                z = self.oz[0] * p.x + self.oz[1] * p.y + self.oz[2] * p.z + self.oz[3]
+                parity = mi.Int32(dr.floor(x / self.size)) + mi.Int32(dr.floor(z / self.size))
+                return dr.select((parity & 1) != 0, mi.Color3f(self.odd), mi.Color3f(self.even))
+
+            def eval_1(self, si, active=True):
+                return dr.mean(self.eval(si, active))
+
+            def mean(self):
+                return 0.5 * (sum(self.even) + sum(self.odd)) / 3.0
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceChecker[size=%g]" % self.size
+
+        mi.register_texture("wt_checker", lambda props: Checker(props))
+
+    if "wt_scale" in names:
+        class Scale(mi.Texture):
+            """A texture times a constant colour (wavetrace's albedo x texture)."""
+
+            def __init__(self, props):
+                mi.Texture.__init__(self, props)
+                self.nested = props.get("texture")
+                self.factor = mi.ScalarColor3f(props.get("r"), props.get("g"), props.get("b"))
+
+            def eval(self, si, active=True):
+                return self.nested.eval(si, active) * mi.Color3f(self.factor)
+
+            def eval_1(self, si, active=True):
+                return dr.mean(self.eval(si, active))
+
+            def mean(self):
+                return self.nested.mean() * sum(self.factor) / 3.0
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceScale"
+
+        mi.register_texture("wt_scale", lambda props: Scale(props))
+
+    if "wt_null" in names:
+        def zeros(cls):
+            try:
+                return dr.zeros(cls)
+            except RuntimeError:  # scalar variants: Mitsuba's records construct as zeros
+                return cls()
+
+        class Null(mi.Emitter):
+            """Takes the light samples of a scene whose emitters wavetrace does not
+            sample, and returns none (Mitsuba 3.7 needs a non-zero total weight)."""
+
+            def __init__(self, props):
+                mi.Emitter.__init__(self, props)
+                self.m_flags = mi.EmitterFlags.DeltaPosition
+
+            def sample_direction(self, it, sample, active=True):
+                return zeros(mi.DirectionSample3f), zeros(mi.Color3f)
+
+            def pdf_direction(self, it, ds, active=True):
+                return zeros(mi.Float)
+
+            def eval_direction(self, it, ds, active=True):
+                return zeros(mi.Color3f)
+
+            def eval(self, si, active=True):
+                return zeros(mi.Color3f)
+
+            def sample_ray(self, time, sample1, sample2, sample3, active=True):
+                return zeros(mi.Ray3f), zeros(mi.Color3f)
+
+            def sample_position(self, ref, ds, active=True):
+                return zeros(mi.PositionSample3f), zeros(mi.Float)
+
+            def bbox(self):
+                return mi.ScalarBoundingBox3f()
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceNullEmitter"
+
+        mi.register_emitter("wt_null", lambda props: Null(props))
+
+
+def _bitmap_rows(mi, path, srgb):
+    """An image file as linear RGB rows (lists of floats), top first."""
+    bmp = mi.Bitmap(path)
+    if bmp.component_format() != mi.Struct.Type.Float32 or bmp.pixel_format() != mi.Bitmap.PixelFormat.RGB:
+        if bmp.component_format() in (mi.Struct.Type.UInt8, mi.Struct.Type.UInt16):
+            bmp.set_srgb_gamma(bool(srgb))
+        bmp = bmp.convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, False)
+    import drjit as dr
+    w, h = bmp.size()
+    flat = array.array("f", dr.scalar.TensorXf(bmp).array)   # host memory, whatever the variant
+    return w, h, [flat[3 * w * y:3 * w * (y + 1)] for y in range(h)]
+
+
+def _sample_rows(w, h, rows, u, v):
+    """wavetrace's bilinear lookup: u wraps, v clamps, texel centres at half-integers."""
+    x = (u - math.floor(u)) * w - 0.5
+    y = min(max(v, 0.0), 1.0) * h - 0.5
+    fx, fy = math.floor(x), math.floor(y)
+    ax, ay = x - fx, y - fy
+    x0, y0 = int(fx), int(fy)
+    x1, y1 = x0 + 1, y0 + 1
+    x0 = x0 + w if x0 < 0 else x0
+    x1 = x1 - w if x1 >= w else x1
+    y0 = max(y0, 0)
+    y1 = min(y1, h - 1)
+    out = []
+    for ch in range(3):
+        top = (1 - ax) * rows[y0][3 * x0 + ch] + ax * rows[y0][3 * x1 + ch]
+        bot = (1 - ax) * rows[y1][3 * x0 + ch] + ax * rows[y1][3 * x1 + ch]
+        out.append((1 - ay) * top + ay * bot)
+    return out
+
+
+def environment_uv(mapping, e):
+    """wavetrace's environment_uv (include/wavetrace/sky.hpp) for a unit direction."""
+    x, y, z = e
+    if mapping == "angular":
+        side = math.sqrt(x * x + y * y)
+        if side == 0:
+            return (0.5, 0.5) if z <= 0 else (1.0, 0.5)
+        r = math.acos(min(max(-z, -1.0), 1.0)) / math.pi / side
+        return 0.5 + 0.5 * x * r, 0.5 - 0.5 * y * r
+    if mapping == "mirror_ball":
+        h = (x, y, z + 1.0)
+        ln = math.sqrt(sum(c * c for c in h))
+        if ln == 0:
+            return 1.0, 0.5
+        return 0.5 + 0.5 * h[0] / ln, 0.5 - 0.5 * h[1] / ln
+    return (math.atan2(x, -z) / (2 * math.pi)) % 1.0, math.acos(min(max(y, -1.0), 1.0)) / math.pi
+
+
+def environment_to_latlong(mi, spec):
+    """A lat-long PFM (in Mitsuba's envmap row convention) of an environment image."""
+    key = _source_key(spec["file"], spec["mapping"], spec["srgb"], RESAMPLED_SKY_ROWS)
+    out = os.path.join(cache_dir(), "environment-%s.pfm" % key)
+    if os.path.exists(out):
+        return out
+    w, h, rows = _bitmap_rows(mi, spec["file"], spec["srgb"])
+    if spec["mapping"] == "latlong":
+        write_pfm(out, w, h, rows)
+        return out
+    H = RESAMPLED_SKY_ROWS
+    W = 2 * H
+    result = []
+    for i in range(H):
+        theta = math.pi * i / (H - 1)
+        row = array.array("f")
+        for j in range(W):
+            phi = 2 * math.pi * (j + 0.5) / W
+            d = (math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi))
+            u, v = environment_uv(spec["mapping"], d)
+            row.extend(_sample_rows(w, h, rows, u, v))
+        result.append(row)
+    write_pfm(out, W, H, result)
+    return out
+
+
+def realize(mi, d):
+    """The plain dict with transforms made Mitsuba transforms."""
+    if isinstance(d, dict):
+        if "__transform__" in d:
+            return mi.ScalarTransform4f(mi.ScalarMatrix4f(d["__transform__"]))
+        out = {}
+        for k, v in d.items():
+            if k == "__envmap_image__":
+                out["filename"] = environment_to_latlong(mi, v)
+            else:
+                out[k] = realize(mi, v)
+        return out
+    if isinstance(d, list):
+        return [realize(mi, v) for v in d]
+    return d
+
+
+def load_scene(conversion, variant):
+    import mitsuba as mi
+    import drjit as dr
+    if mi.variant() != variant:
+        mi.set_variant(variant)
+    register_python_plugins(mi, dr, conversion.python_plugins)
+    return mi.load_dict(realize(mi, conversion.scene))
+
+
+# --------------------------------------------------------------------------
+# The runner
+# --------------------------------------------------------------------------
+
+def device_info(variant):
+    info = {"variant": variant}
+    if variant.startswith("cuda"):
+        try:
+            out = subprocess.run(["nvidia-smi", "--query-gpu=name,driver_version", "--format=csv,noheader"],
+                                 capture_output=True, text=True, timeout=20)
+            if out.returncode == 0 and out.stdout.strip():
+                name, driver = [s.strip() for s in out.stdout.strip().splitlines()[0].split(",", 1)]
+                info.update({"device": name, "driver": driver})
+        except (OSError, subprocess.SubprocessError, ValueError):
+            pass
+    else:
+        info["device"] = platform.processor() or platform.machine()
+    return info
+
+
+def pass_plan(width, height, spp, mode, lane_budget, passes):
+    """Samples per pass. Symbolic loops keep a path's state in registers: one
+    pass (up to Dr.Jit's 2^32 lanes). Evaluated loops keep it in memory, about
+    a hundred bytes and more a lane: passes of at most lane_budget lanes."""
+    pixels = width * height
+    if passes in (None, "auto"):
+        limit = (2 ** 32 - 1) if mode == "symbolic" else lane_budget
+        per = max(1, min(spp, limit // pixels))
+        n = -(-spp // per)
+    else:
+        n = max(1, min(int(passes), spp))
+    base, extra = divmod(spp, n)
+    return [base + (1 if i < extra else 0) for i in range(n)]
+
+
+def render_once(mi, dr, scene, plan, seed):
+    """All passes of one render: the spp-weighted mean of the passes' images."""
+    if len(plan) == 1:
+        img = mi.render(scene, spp=plan[0], seed=seed)
+        dr.eval(img)
+        return img
+    total = sum(plan)
+    acc = None
+    for i, spp in enumerate(plan):
+        img = mi.render(scene, spp=spp, seed=seed + i)
+        acc = img * (spp / total) if acc is None else acc + img * (spp / total)
+    dr.eval(acc)
+    return acc
+
+
+def run_mode(mi, dr, scene, conv, mode, args):
+    dr.set_flag(dr.JitFlag.SymbolicLoops, mode == "symbolic")
+    s = conv.settings
+    plan = pass_plan(s["width"], s["height"], s["spp"], mode, args.lane_budget, args.passes)
+    dr.sync_thread()
+    t0 = time.perf_counter()
+    for _ in range(args.warmup):
+        render_once(mi, dr, scene, plan, s["seed"])
+    dr.sync_thread()
+    warmup_seconds = time.perf_counter() - t0
+    seconds = []
+    img = None
+    for _ in range(args.repeats):
+        del img
+        dr.sync_thread()
+        t0 = time.perf_counter()
+        img = render_once(mi, dr, scene, plan, s["seed"])
+        dr.sync_thread()
+        seconds.append(time.perf_counter() - t0)
+    kernel = None
+    if args.kernel_history and hasattr(dr.JitFlag, "KernelHistory"):
+        dr.kernel_history_clear()
+        with dr.scoped_set_flag(dr.JitFlag.KernelHistory, True):
+            render_once(mi, dr, scene, plan, s["seed"])
+            dr.sync_thread()
+            hist = dr.kernel_history()
+        jit = [h for h in hist if h.get("type") == dr.KernelType.JIT]
+        kernel = {"kernels": len(jit), "kernel_seconds": sum(h.get("execution_time", 0.0) for h in hist) / 1000.0}
+    return img, plan, warmup_seconds, seconds, kernel
+
+
+def median(xs):
+    ys = sorted(xs)
+    n = len(ys)
+    return ys[n // 2] if n % 2 else 0.5 * (ys[n // 2 - 1] + ys[n // 2])
+
+
+def cmd_render(args):
+    conv = convert(args.scene, **convert_kwargs(args))
+    for n in conv.notes:
+        print("note: " + n, file=sys.stderr)
+    import mitsuba as mi
+    import drjit as dr
+    t0 = time.perf_counter()
+    mi.set_variant(args.variant)
+    scene = load_scene(conv, args.variant)
+    dr.sync_thread()
+    load_seconds = time.perf_counter() - t0
+    s = conv.settings
+    paths = s["width"] * s["height"] * s["spp"]
+    modes = ["symbolic", "evaluated"] if args.mode == "both" else [args.mode]
+    records = []
+    for mode in modes:
+        img, plan, warm, seconds, kernel = run_mode(mi, dr, scene, conv, mode, args)
+        med = median(seconds)
+        rec = {
+            "renderer": "mitsuba3",
+            "scene": os.path.relpath(os.path.abspath(args.scene)),
+            "width": s["width"], "height": s["height"], "spp": s["spp"], "depth": s["depth"],
+            "roulette_depth": s["roulette_depth"], "seed": s["seed"], "nee": s["nee"],
+            "mode": mode, "variant": args.variant, "passes": plan,
+            "warmup": args.warmup, "warmup_seconds": warm, "repeats": args.repeats,
+            "seconds": seconds, "median_seconds": med, "m_paths_per_s": paths / med / 1e6,
+            "load_seconds": load_seconds,
+            "notes": conv.notes, "python_plugins": conv.python_plugins,
+            "mitsuba_version": mi.__version__, "drjit_version": dr.__version__,
+            "python": platform.python_version(),
+            "time": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        }
+        rec.update(device_info(args.variant))
+        if kernel:
+            rec.update(kernel)
+        if args.output:
+            base = "%s-%s" % (args.output, mode)
+            os.makedirs(os.path.dirname(os.path.abspath(base)), exist_ok=True)
+            mi.util.write_bitmap(base + ".exr", img)
+            mi.util.write_bitmap(base + ".png", img)
+            rec["images"] = [base + ".exr", base + ".png"]
+        print("%s %s %dx%d %d spp depth %d: %s s (median %.4f s), %.1f M paths/s"
+              % (os.path.basename(args.scene), mode, s["width"], s["height"], s["spp"], s["depth"],
+                 " ".join("%.4f" % x for x in seconds), med, paths / med / 1e6))
+        records.append(rec)
+        del img
+    if args.json:
+        existing = []
+        if os.path.exists(args.json):
+            with open(args.json, encoding="utf-8") as f:
+                existing = json.load(f)
+        existing.extend(records)
+        tmp = args.json + ".tmp"
+        with open(tmp, "w", encoding="utf-8") as f:
+            json.dump(existing, f, indent=1)
+            f.write("\n")
+        os.replace(tmp, args.json)
+    return 0
+
+
+def cmd_convert(args):
+    conv = convert(args.scene, **convert_kwargs(args))
+    print(json.dumps({"settings": conv.settings, "plugins": conv.plugins(), "python_plugins": conv.python_plugins,
+                      "scene": conv.scene}, indent=1))
+    print("could not map (%d):" % len(conv.notes), file=sys.stderr)
+    for n in conv.notes:
+        print("  - " + n, file=sys.stderr)
+    return 0
+
+
+def convert_kwargs(args):
+    return {"width": args.width, "height": args.height, "spp": args.spp, "depth": args.depth,
+            "roulette_depth": args.roulette_depth, "seed": args.seed, "nee": args.nee,
+            "instancing": args.instancing, "sky_sampling": args.sky_sampling,
+            "python_plugins": not args.no_python_plugins}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    for name in ("convert", "render"):
+        p = sub.add_parser(name)
+        p.add_argument("scene")
+        p.add_argument("--width", type=int)
+        p.add_argument("--height", type=int)
+        p.add_argument("--spp", type=int)
+        p.add_argument("--depth", type=int)
+        p.add_argument("--roulette-depth", type=int)
+        p.add_argument("--seed", type=int)
+        p.add_argument("--nee", type=int, choices=(0, 1))
+        p.add_argument("--instancing", action="store_true",
+                       help="share a mesh placed more than once through a Mitsuba shapegroup (default: every "
+                            "placement is a shape of its own; see the note the conversion prints)")
+        p.add_argument("--no-python-plugins", action="store_true",
+                       help="only Mitsuba's own plugins: checker -> mean colour, no albedo x image, and the sky "
+                            "sampled as a light even where wavetrace does not sample it (notes say so)")
+        p.add_argument("--sky-sampling", choices=("auto", "always"), default="auto",
+                       help="auto: the sky is a sampled light where wavetrace samples it (not the gradient)")
+        if name == "render":
+            p.add_argument("--mode", choices=("symbolic", "evaluated", "both"), default="both")
+            p.add_argument("--variant", default="cuda_ad_rgb")
+            p.add_argument("-o", "--output", help="image prefix: PREFIX-MODE.exr and .png")
+            p.add_argument("--json", help="append a record per mode to this JSON list")
+            p.add_argument("--warmup", type=int, default=1)
+            p.add_argument("--repeats", type=int, default=3)
+            p.add_argument("--passes", default="auto", help="render passes per image (auto: see pass_plan)")
+            p.add_argument("--lane-budget", type=int, default=2 ** 26,
+                           help="most samples a pass of the evaluated mode holds (default 2^26)")
+            p.add_argument("--kernel-history", action="store_true",
+                           help="one more render with Dr.Jit's kernel history: kernel count and device seconds")
+    args = ap.parse_args(argv)
+    try:
+        return cmd_convert(args) if args.command == "convert" else cmd_render(args)
+    except ConversionError as e:
+        print("%s: %s" % (args.scene, e), file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
