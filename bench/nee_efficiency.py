@@ -56,6 +56,8 @@ def main():
             rows.append((scene, ratio))
             print(f"\nAt equal time light sampling's MSE is {ratio:.1f}x lower (MSE x seconds, {pt[0]} spp "
                   f"path tracing against {nee[0]} spp light sampling).\n")
+        else:
+            print()
     return 0
 
 
