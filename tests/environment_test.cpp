@@ -277,15 +277,7 @@ class EnvironmentRender : public testing::TestWithParam<Variant> {
 // blends texels of 1): a white sphere is 1 everywhere, as under the uniform sky.
 TEST_P(EnvironmentRender, ConstantEnvironmentIsTheFurnace) {
   Scene scene = parse_scene(sky_scene(R"({"type": "uniform", "radiance": [1, 1, 1]})"), "furnace.json");
-  Image one;
-  one.path = "one";
-  one.width = 5;
-  one.height = 3;
-  one.texels.assign(5 * 3 * 4, 1.0f);
-  scene.sky = Sky{SkyKind::Environment, vec3(0.0f), vec3(0.0f)};
-  scene.sky.image = static_cast<int32_t>(scene.images.size());
-  scene.images.push_back(one);
-  build_bvh(scene);  // the sky's light table, for the sky set here
+  test::set_constant_environment(scene, 5, 3);
   RenderOptions o = options_for(GetParam().backend, GetParam().kernel, 24, 16, 4, 8, 100, 7);
   o.params.nee = 0;  // exact for path tracing; with light sampling in expectation (light_sampling_render_test)
   const RenderResult r = render(scene, o);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "render/renderer.hpp"
+#include "scene/scene.hpp"
 
 namespace wt::test {
 
@@ -50,6 +51,38 @@ inline RenderOptions options_for(Backend b, Kernel k, int w, int h, int spp, int
 }
 
 inline double mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }
+
+// Image means of renders with two settings that must estimate the same value (one
+// mean per seed): they agree within four standard errors of their difference (each
+// from its own seeds' spread, plus 1e-4 of the value), and within `relative` of it.
+inline void expect_same_expectation(const std::vector<double>& a, const std::vector<double>& b, double relative) {
+  auto stats = [](const std::vector<double>& v, double& avg, double& se) {
+    avg = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+    double var = 0;
+    for (double x : v) var += (x - avg) * (x - avg);
+    se = std::sqrt(var / (v.size() - 1) / v.size());
+  };
+  double ma, sa, mb, sb;
+  stats(a, ma, sa);
+  stats(b, mb, sb);
+  EXPECT_NEAR(ma, mb, 4.0 * std::sqrt(sa * sa + sb * sb) + 1e-4 * mb)
+      << ma << " +- " << sa << " against " << mb << " +- " << sb;
+  EXPECT_NEAR(ma, mb, relative * mb) << ma << " +- " << sa << " against " << mb << " +- " << sb;
+}
+
+// The scene's sky made a LatLong environment of radiance 1 everywhere (a w x h
+// image: every lookup blends texels of 1), its lights and table rebuilt for it.
+inline void set_constant_environment(Scene& scene, int w, int h) {
+  Image one;
+  one.path = "one";
+  one.width = w;
+  one.height = h;
+  one.texels.assign(static_cast<size_t>(w) * h * 4, 1.0f);
+  scene.sky = Sky{SkyKind::Environment, vec3(0.0f), vec3(0.0f)};
+  scene.sky.image = static_cast<int32_t>(scene.images.size());
+  scene.images.push_back(one);
+  build_bvh(scene);
+}
 
 inline double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
   double s = 0;
