@@ -15,6 +15,9 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
       ->check(CLI::IsMember(backend_choices()));
   cmd.add_option("--kernel", job.kernel, "the kernel: " + listed(kernel_names()))
       ->check(CLI::IsMember(kernel_names()));
+  cmd.add_option("--devices", job.devices,
+                 "split the render over these devices: all (default: every CUDA device) or indices such as 0,1 "
+                 "(on the cpu backend, as many host devices, each a share of the threads)");
   cmd.add_option("--encoding", encoding, "PNG encoding: srgb or gamma2 (the reference renderer's curve)")
       ->check(CLI::IsMember(encoding_choices()));
   cmd.add_flag_callback("--no-nee", [&job] { set_setting(job, SettingId::Nee, 0); },
@@ -64,6 +67,7 @@ std::vector<std::string> render_arguments(const Job& job) {
   }
   add("--backend", job.backend);
   add("--kernel", job.kernel);
+  if (job.devices != "all") add("--devices", job.devices);
   add("--encoding", encoding_choices()[job.encoding == Encoding::Srgb ? 0 : 1]);
   if (job.exr_float) args.push_back("--exr-float");
   if (!job.progress) args.push_back("--quiet");

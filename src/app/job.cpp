@@ -29,6 +29,33 @@ Backend parse_backend(const std::string& name) {
   throw SceneError("backend: unknown backend '" + name + "' (expected cuda, cpu or auto)");
 }
 
+std::vector<int> parse_devices(const std::string& text, Backend backend, int present) {
+  if (text == "all" || text.empty()) {
+    std::vector<int> all;
+    if (backend == Backend::Cuda) {
+      for (int d = 0; d < present; ++d) all.push_back(d);
+    }
+    return all;
+  }
+  std::vector<int> out;
+  size_t at = 0;
+  while (at <= text.size()) {
+    const size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    const bool digits = !item.empty() && item.size() <= 4 && item.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits) {
+      throw SceneError("devices: '" + text + "' is not 'all' or a list of device indices such as 0,1");
+    }
+    const int d = std::stoi(item);
+    if (backend == Backend::Cuda && d >= present) {
+      throw SceneError("devices: " + item + " is not a CUDA device (" + std::to_string(present) + " present)");
+    }
+    out.push_back(d);
+    at = comma + 1;
+  }
+  return out;
+}
+
 namespace {
 
 // The job's field for a render setting (const or not, as the job); null for the others.
@@ -160,6 +187,7 @@ JobOutcome run_job(const Job& job) {
     options.warmup = static_cast<int>(job.warmup);
     options.wave_size = job.wave_size;
     options.threads = static_cast<int>(job.threads);
+    options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
     out.params = options.params;
     out.backend = backend_name(options.backend);
     out.kernel = kernel_name(options.kernel);

@@ -23,6 +23,9 @@ struct Job {
   int64_t warmup = 0;
   int64_t wave_size = 0;  // 0: chosen at run time
   int64_t threads = 0;    // 0: every core
+  // The devices to split the render over: "all" (every CUDA device; on the CPU
+  // backend, one), or indices "0,1" (on the CPU backend, as many host "devices").
+  std::string devices = "all";
   // Checkpoints (docs/checkpoints.md): written to `checkpoint` every
   // `checkpoint_every` seconds and on SIGINT/SIGTERM; `resume` continues from one
   // (an existing `checkpoint` file is resumed too, never overwritten by a new start).
@@ -65,5 +68,8 @@ void set_setting(Job& job, SettingId id, int64_t value);
 std::optional<int64_t> given_setting(const Job& job, SettingId id);
 
 Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
+// Job::devices as the render's device list for `backend` (`present`: CUDA devices
+// present); throws SceneError naming the field for anything else.
+std::vector<int> parse_devices(const std::string& text, Backend backend, int present);
 
 }  // namespace wt::app

@@ -62,6 +62,14 @@ void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, 
   j["m_paths_per_s"] = seconds > 0 ? r.paths / seconds / 1e6 : 0.0;
   j["m_shadow_rays_per_s"] = seconds > 0 ? r.shadow_rays / seconds / 1e6 : 0.0;
   j["rays_per_path"] = r.paths ? static_cast<double>(r.rays) / r.paths : 0.0;
+  if (!r.shares.empty()) {
+    nlohmann::json devices = nlohmann::json::array();
+    for (const DeviceShare& s : r.shares) {
+      devices.push_back({{"device", s.device}, {"name", s.name}, {"samples", s.samples}, {"chunks", s.chunks},
+                         {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}});
+    }
+    j["devices"] = devices;
+  }
   if (!r.stages.empty()) {
     nlohmann::json stages = nlohmann::json::object();
     for (const StageTime& s : r.stages) stages[s.name] = s.ms;

@@ -9,6 +9,7 @@
 #include "cpu/parallel.hpp"
 #include "render/passes.hpp"
 #include "render/settings.hpp"
+#include "render/split.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt::cpu {
@@ -90,6 +91,20 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (!kernel_runs_on(options.kernel, Backend::Cpu)) {
     throw SceneError(std::string("kernel: ") + kernel_name(options.kernel) +
                      " needs the cuda backend (constant memory is a GPU memory)");
+  }
+  if (options.devices.size() > 1) {
+    // Host "devices" (the split's logic without GPUs): each a share of the threads.
+    const int each = std::max(1, thread_count(options.threads) / static_cast<int>(options.devices.size()));
+    std::vector<std::string> labels;
+    for (int d : options.devices) labels.push_back("cpu:" + std::to_string(d));
+    return render_split(options, labels, [&](size_t) -> ChunkRenderer {
+      return [&scene, each](const RenderOptions& chunk) {
+        RenderOptions one = chunk;
+        one.devices.clear();
+        one.threads = each;
+        return render(scene, one);
+      };
+    });
   }
   std::vector<ImageView> images;
   const SceneView view = host_view(scene, rp.width, rp.height, images);

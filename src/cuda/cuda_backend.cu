@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <string>
 
 #include "cuda/buffer.hpp"
@@ -12,6 +13,7 @@
 #include "megakernel/megakernel.hpp"
 #include "cuda/cuda_wavefront.hpp"
 #include "render/passes.hpp"
+#include "render/split.hpp"
 
 namespace wt::cuda {
 
@@ -103,26 +105,66 @@ void require_device_memory(const RenderParams& rp, size_t need, size_t free_byte
   }
 }
 
+namespace {
+
+// The scene on the current device, checked to fit with the render's state, and
+// renders of any of the render's samples over it.
+class Uploaded {
+ public:
+  Uploaded(const Scene& scene, const RenderOptions& options) : scene_(scene), info_(device_info()) {
+    const RenderParams& rp = options.params;
+    wave_ = is_wavefront(options.kernel) ? choose_wave_size(options.wave_size, rp, info_.free_memory) : 0;
+    // Checked before allocating anything: a render that cannot fit fails with a
+    // message rather than with an allocation error halfway through.
+    require_device_memory(rp, render_state_bytes(rp, options.kernel, wave_) + scene.device_bytes(),
+                          info_.free_memory, info_.name);
+    const auto t0 = std::chrono::steady_clock::now();
+    ds_ = std::make_unique<DeviceScene>(scene, rp.width, rp.height);
+    WT_CUDA(cudaDeviceSynchronize(), "scene upload");
+    upload_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  RenderResult render(const RenderOptions& options) const {
+    RenderResult out = is_wavefront(options.kernel)
+                           ? render_wavefront(ds_->view(), scene_.sort_key_bits(), options, wave_)
+                           : render_megakernel(scene_, *ds_, options);
+    out.upload_seconds = upload_;
+    out.device = info_.name;
+    return out;
+  }
+
+ private:
+  const Scene& scene_;
+  DeviceInfo info_;
+  int64_t wave_ = 0;
+  std::unique_ptr<DeviceScene> ds_;
+  double upload_ = 0;
+};
+
+}  // namespace
+
 RenderResult render(const Scene& scene, const RenderOptions& options) {
-  if (device_count() == 0) throw DeviceError("backend: cuda was asked for, but no CUDA device is present");
-  const RenderParams& rp = options.params;
-  DeviceInfo info = device_info();
-
-  const bool wavefront = is_wavefront(options.kernel);
-  int64_t wave = wavefront ? choose_wave_size(options.wave_size, rp, info.free_memory) : 0;
-  // Checked before allocating anything: a render that cannot fit fails with a
-  // message rather than with an allocation error halfway through.
-  require_device_memory(rp, render_state_bytes(rp, options.kernel, wave) + scene.device_bytes(), info.free_memory,
-                        info.name);
-
-  auto t0 = std::chrono::steady_clock::now();
-  DeviceScene ds(scene, rp.width, rp.height);
-  WT_CUDA(cudaDeviceSynchronize(), "scene upload");
-  double upload = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  RenderResult out = wavefront ? render_wavefront(ds.view(), scene.sort_key_bits(), options, wave) : render_megakernel(scene, ds, options);
-  out.upload_seconds = upload;
-  out.device = info.name;
+  const int present = device_count();
+  if (present == 0) throw DeviceError("backend: cuda was asked for, but no CUDA device is present");
+  for (int d : options.devices) {
+    if (d < 0 || d >= present) {
+      throw SceneError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
+                       " present: 0.." + std::to_string(present - 1) + ")");
+    }
+  }
+  if (options.devices.size() > 1) {
+    std::vector<std::string> labels;
+    for (int d : options.devices) labels.push_back("cuda:" + std::to_string(d));
+    return render_split(options, labels, [&](size_t i) -> ChunkRenderer {
+      // The current device is the calling thread's: the worker's from here on.
+      WT_CUDA(cudaSetDevice(options.devices[i]), "device selection");
+      auto uploaded = std::make_shared<Uploaded>(scene, options);
+      return [uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); };
+    });
+  }
+  if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
+  const Uploaded uploaded(scene, options);
+  RenderResult out = uploaded.render(options);
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;
 }

@@ -59,8 +59,12 @@ struct ConstantScene {
   __device__ const PiecewiseConstant2D& environment_table() const { return layout.environment; }
 };
 
-ConstantScene g_scene{};  // host copy of the accessor, filled by upload_constant_scene
-uint32_t g_kinds = kAllKinds;  // the uploaded scene's primitive kinds
+// The host copy of the accessor, filled by upload_constant_scene, and the uploaded
+// scene's primitive kinds: per host thread, as the current device is (a render split
+// over devices uploads and launches on each device from its own thread, and the
+// accessor holds that device's pointers).
+thread_local ConstantScene g_scene{};
+thread_local uint32_t g_kinds = kAllKinds;
 
 size_t align16(size_t n) { return (n + 15) & ~size_t(15); }
 

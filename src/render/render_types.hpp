@@ -44,6 +44,10 @@ struct RenderOptions {
   int warmup = 0;         // untimed renders before the timed one, on every backend
   int64_t wave_size = 0;  // wavefront path slots; 0 chooses (queues/wave.hpp)
   int threads = 0;        // CPU threads; 0 uses every core
+  // The devices to split the render over (render/split.hpp): CUDA device indices,
+  // or on the CPU backend host "devices" (each a share of the threads). None or
+  // one: one device (the current CUDA device where none is named).
+  std::vector<int> devices;
   ProgressFn progress;    // may be empty
 
   // The samples of every pixel this render adds: [first_sample, first_sample +
@@ -58,6 +62,16 @@ struct RenderOptions {
   int32_t samples_per_pass = 0;
   uint64_t max_paths_per_pass = kMaxPathsPerPass;  // lowered only by tests
   PassFn after_pass;
+};
+
+// What one device did in a render split over several (render/split.hpp).
+struct DeviceShare {
+  std::string device;  // "cuda:1", "cpu:0"
+  std::string name;    // what the backend calls it ("NVIDIA H200", "CPU (8 threads)")
+  int32_t samples = 0;  // samples per pixel it rendered
+  int32_t chunks = 0;
+  double seconds = 0;   // its renders' own time
+  uint64_t rays = 0, shadow_rays = 0;
 };
 
 struct StageTime {
@@ -84,6 +98,7 @@ struct RenderResult {
   std::vector<uint64_t> live_per_bounce;  // wavefront: paths alive entering each bounce
   // wavefront: the bounces (wave steps) with hits, and those whose hits were sorted
   uint64_t bounces_shaded = 0, bounces_sorted = 0;
+  std::vector<DeviceShare> shares;  // a render split over several devices: each one's part
 };
 
 }  // namespace wt

@@ -1,0 +1,176 @@
+// One render over several devices (the GPUs of a host, or host "devices" of the CPU
+// backend): its samples are cut into chunks (the passes the render would make on one
+// device), handed to the devices as they free up, so that a faster or less busy
+// device takes more of them, and folded into the film in the chunks' order. The
+// counter-based random numbers make a path's value independent of where it runs, so
+// the image is the one-device image up to the order of float additions.
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cuda/device.hpp"
+#include "render/passes.hpp"
+#include "render/render_types.hpp"
+#include "scene/scene.hpp"
+
+namespace wt {
+
+// Chunks a device gets at least, on average: enough for a faster device to take more.
+constexpr int kChunksPerDevice = 4;
+// At least as many chunks as the CUDA megakernel makes passes on one device: for two
+// devices the chunks are its passes, and its image is the same to the bit.
+constexpr int kMinChunks = 10;
+
+// What renders one device's chunks: made on that device's own thread (where it may
+// upload the scene), then called with each chunk's options, returning the chunk's
+// pixel sums (Radiance::SumOfSamples) and its counts.
+using ChunkRenderer = std::function<RenderResult(const RenderOptions& chunk)>;
+using MakeChunkRenderer = std::function<ChunkRenderer(size_t device)>;
+
+namespace split_detail {
+
+// The exception `e` again, of the same kind, its message led by the device's name.
+[[noreturn]] inline void rethrow_naming(const std::exception_ptr& e, const std::string& device) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const SceneError& x) {
+    throw SceneError(device + ": " + x.what());
+  } catch (const cuda::CudaError& x) {
+    throw cuda::CudaError(device + ": " + x.what());
+  } catch (const DeviceError& x) {
+    throw DeviceError(device + ": " + x.what());
+  }
+}
+
+}  // namespace split_detail
+
+// Renders `options` over the devices `labels` names (one worker thread each). The
+// result's shares say what each device did; its seconds run from when every device
+// has its scene (and its warm-up renders) to the last chunk. A device that fails
+// stops the others after their current chunk, and the render throws its error,
+// named after the device; no partial result is returned.
+inline RenderResult render_split(const RenderOptions& options, const std::vector<std::string>& labels,
+                                 const MakeChunkRenderer& make) {
+  const size_t devices = labels.size();
+  const RenderParams& rp = options.params;
+  const std::vector<SamplePass> chunks =
+      plan_passes(options, std::max<int>(kMinChunks, kChunksPerDevice * static_cast<int>(devices)));
+  const size_t floats = static_cast<size_t>(rp.width) * rp.height * 3;
+
+  RenderResult out;
+  out.rgb = options.initial_film ? *options.initial_film : std::vector<float>(floats, 0.0f);
+  out.radiance = Radiance::SumOfSamples;
+  out.samples = options.first_sample;
+  out.shares.resize(devices);
+  for (size_t d = 0; d < devices; ++d) out.shares[d].device = labels[d];
+
+  std::mutex m;
+  std::condition_variable ready_cv;
+  size_t ready = 0, next = 0, folded = 0;
+  std::vector<std::vector<float>> waiting(chunks.size());  // chunk sums not yet folded
+  std::vector<char> finished(chunks.size(), 0);
+  bool stop = false;
+  std::exception_ptr error;
+  std::string failed_device;
+  std::chrono::steady_clock::time_point start;
+
+  // Folds finished chunks into the film in their order (under m); false when
+  // after_pass asked to stop.
+  auto fold = [&]() {
+    while (folded < chunks.size() && finished[folded]) {
+      const std::vector<float>& sums = waiting[folded];
+      for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
+      std::vector<float>().swap(waiting[folded]);
+      out.samples = chunks[folded].first + chunks[folded].count;
+      ++folded;
+      if (options.after_pass && !options.after_pass(out.samples, [&] { return out.rgb; })) return false;
+      if (options.progress) {
+        uint64_t rays = 0;
+        for (const DeviceShare& s : out.shares) rays += s.rays;
+        options.progress(static_cast<double>(folded) / chunks.size(), rays,
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      }
+    }
+    return true;
+  };
+
+  auto work = [&](size_t d) {
+    try {
+      ChunkRenderer render_chunk = make(d);
+      RenderOptions chunk = options;
+      chunk.initial_film = nullptr;
+      chunk.after_pass = {};
+      chunk.progress = {};
+      chunk.samples_per_pass = 0;
+      if (options.warmup > 0 && !chunks.empty()) {
+        chunk.first_sample = chunks[0].first;
+        chunk.sample_count = chunks[0].count;
+        render_chunk(chunk);  // the warm-ups, untimed, before the start
+      }
+      chunk.warmup = 0;
+      {
+        std::unique_lock<std::mutex> lock(m);
+        if (++ready == devices) {
+          start = std::chrono::steady_clock::now();
+          ready_cv.notify_all();
+        }
+        ready_cv.wait(lock, [&] { return ready == devices || stop; });
+      }
+      for (;;) {
+        size_t c;
+        {
+          std::lock_guard<std::mutex> lock(m);
+          if (stop || next >= chunks.size()) break;
+          c = next++;
+        }
+        chunk.first_sample = chunks[c].first;
+        chunk.sample_count = chunks[c].count;
+        RenderResult r = render_chunk(chunk);
+        std::lock_guard<std::mutex> lock(m);
+        DeviceShare& share = out.shares[d];
+        share.samples += chunks[c].count;
+        share.chunks += 1;
+        share.seconds += r.seconds;
+        share.rays += r.rays;
+        share.shadow_rays += r.shadow_rays;
+        if (share.name.empty()) share.name = r.device;
+        out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
+        waiting[c] = std::move(r.rgb);
+        finished[c] = 1;
+        if (!stop && !fold()) stop = true;
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!error) {
+        error = std::current_exception();
+        failed_device = labels[d];
+      }
+      stop = true;
+      ready_cv.notify_all();
+    }
+  };
+
+  std::vector<std::thread> threads;
+  for (size_t d = 0; d < devices; ++d) threads.emplace_back(work, d);
+  for (std::thread& t : threads) t.join();
+  if (error) split_detail::rethrow_naming(error, failed_device);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.interrupted = folded < chunks.size();
+  for (const DeviceShare& s : out.shares) {
+    out.rays += s.rays;
+    out.shadow_rays += s.shadow_rays;
+  }
+  out.paths = static_cast<uint64_t>(out.samples - options.first_sample) * rp.width * rp.height;
+  out.device = std::to_string(devices) + " devices";
+  return out;
+}
+
+}  // namespace wt

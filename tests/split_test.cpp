@@ -1,0 +1,200 @@
+// A render split over several devices (render/split.hpp): on host "devices" of the
+// CPU backend, and on one GPU named twice (the split's logic on a machine with one
+// device). The N-way image is the one-way image within float-summation rounding (a
+// pixel's samples summed in other groups); bit for bit with the CUDA megakernel on
+// two devices, whose ten passes are then the split's ten chunks. Checkpoint
+// passes, resumption, stopping and a failing device behave as on one device.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "app/job.hpp"
+#include "cuda/device.hpp"
+#include "render/renderer.hpp"
+#include "render/split.hpp"
+#include "render_support.hpp"
+#include "test_support.hpp"
+
+namespace wt {
+namespace {
+
+using test::mean;
+using test::options_for;
+
+// The bound of a split against one device: a pixel's sum of 12 samples added in
+// other groups, relatively (float rounding of a few additions).
+constexpr float kReorderBound = 1e-5f;
+
+const Scene& quick() {
+  static const Scene scene = load_scene(test::repo_path("scenes/quick.json"));
+  return scene;
+}
+
+RenderOptions quick_options(Backend b, Kernel k, std::vector<int> devices) {
+  RenderOptions o = options_for(b, k, 64, 36, 12, 8, 3, 5);
+  o.devices = std::move(devices);
+  return o;
+}
+
+void expect_same_image(const RenderResult& one, const RenderResult& split, bool bitwise, const std::string& what) {
+  ASSERT_EQ(one.rgb.size(), split.rgb.size()) << what;
+  for (size_t i = 0; i < one.rgb.size(); ++i) {
+    if (bitwise) {
+      ASSERT_EQ(one.rgb[i], split.rgb[i]) << what << " " << i;
+    } else {
+      ASSERT_NEAR(one.rgb[i], split.rgb[i], kReorderBound * (1.0f + std::fabs(one.rgb[i]))) << what << " " << i;
+    }
+  }
+  EXPECT_EQ(one.rays, split.rays) << what;
+  EXPECT_EQ(one.shadow_rays, split.shadow_rays) << what;
+  EXPECT_EQ(one.paths, split.paths) << what;
+  EXPECT_EQ(one.samples, split.samples) << what;
+}
+
+TEST(Split, HostDevicesRenderTheOneDeviceImage) {
+  for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
+    const RenderResult one = render(quick(), quick_options(Backend::Cpu, k, {}));
+    for (const std::vector<int>& devices : {std::vector<int>{0, 1}, std::vector<int>{0, 1, 2}}) {
+      const RenderResult split = render(quick(), quick_options(Backend::Cpu, k, devices));
+      const std::string what = std::string(kernel_name(k)) + " on " + std::to_string(devices.size());
+      expect_same_image(one, split, false, what);
+      ASSERT_EQ(split.shares.size(), devices.size()) << what;
+      int samples = 0, chunks = 0;
+      for (const DeviceShare& s : split.shares) {
+        EXPECT_GT(s.chunks, 0) << what << ": " << s.device << " got no chunk";
+        samples += s.samples;
+        chunks += s.chunks;
+      }
+      EXPECT_EQ(samples, 12) << what;
+      EXPECT_EQ(chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * static_cast<int>(devices.size()))))
+          << what;
+      EXPECT_TRUE(one.shares.empty());
+    }
+  }
+}
+
+// Checkpoint passes: after_pass sees the samples grow chunk by chunk in order, and
+// each film it reads is the one-device render of that many samples; returning false
+// stops the render there, interrupted, with the samples so far.
+TEST(Split, PassesArriveInOrderAndStopWhereAsked) {
+  RenderOptions o = quick_options(Backend::Cpu, Kernel::Megakernel, {0, 1, 2});
+  o.samples_per_pass = 2;
+  std::vector<int32_t> seen;
+  std::vector<float> at_six;
+  o.after_pass = [&](int32_t samples, const FilmReader& film) {
+    seen.push_back(samples);
+    if (samples == 6) at_six = film();
+    return samples < 8;
+  };
+  const RenderResult r = render(quick(), o);
+  // (Three devices: twelve chunks, one sample each; passes of at most 2 samples
+  // are respected by making the chunks no larger.)
+  ASSERT_EQ(seen.size(), 8u);
+  for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], static_cast<int32_t>(i + 1));
+  EXPECT_EQ(seen.back(), 8);
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_EQ(r.samples, 8);
+
+  RenderOptions six = quick_options(Backend::Cpu, Kernel::Megakernel, {});
+  six.params.spp = 6;
+  const RenderResult first_six = render(quick(), six);
+  ASSERT_EQ(at_six.size(), first_six.rgb.size());
+  for (size_t i = 0; i < at_six.size(); ++i) {
+    ASSERT_NEAR(at_six[i] / 6.0f, first_six.rgb[i], kReorderBound * (1.0f + first_six.rgb[i])) << i;
+  }
+}
+
+// Resuming from a film of the first samples, split, gives the whole render.
+TEST(Split, AResumedSplitRenderIsTheWholeRender) {
+  const RenderResult whole = render(quick(), quick_options(Backend::Cpu, Kernel::Megakernel, {}));
+  RenderOptions part = quick_options(Backend::Cpu, Kernel::Megakernel, {});
+  part.sample_count = 5;
+  RenderResult first = render(quick(), part);
+  for (float& v : first.rgb) v *= 5.0f;  // back to sums
+  RenderOptions rest = quick_options(Backend::Cpu, Kernel::Megakernel, {0, 1});
+  rest.first_sample = 5;
+  rest.initial_film = &first.rgb;
+  const RenderResult resumed = render(quick(), rest);
+  EXPECT_EQ(resumed.samples, 12);
+  for (size_t i = 0; i < whole.rgb.size(); ++i) ASSERT_NEAR(resumed.rgb[i], whole.rgb[i], 1e-6f * (1 + whole.rgb[i]));
+}
+
+// A device that fails stops the render: the error is the device's, of its kind,
+// named after it, and no result comes back.
+TEST(Split, AFailingDeviceFailsTheRenderAndSaysWhich) {
+  const RenderOptions o = quick_options(Backend::Cpu, Kernel::Megakernel, {});
+  std::atomic<int> chunks_done{0};
+  auto make = [&](size_t d) -> ChunkRenderer {
+    if (d == 2) throw DeviceError("out of device memory");
+    return [&](const RenderOptions& chunk) {
+      ++chunks_done;
+      return render(quick(), chunk);
+    };
+  };
+  try {
+    render_split(o, {"gpu:0", "gpu:1", "gpu:2"}, make);
+    FAIL() << "the render should have failed";
+  } catch (const DeviceError& e) {
+    EXPECT_EQ(std::string(e.what()), "gpu:2: out of device memory");
+  }
+  auto bad_chunk = [&](size_t d) -> ChunkRenderer {
+    return [d](const RenderOptions&) -> RenderResult {
+      if (d == 1) throw SceneError("width x height: too large for this device");
+      return RenderResult{};
+    };
+  };
+  EXPECT_THROW(render_split(o, {"gpu:0", "gpu:1"}, bad_chunk), SceneError);
+}
+
+TEST(Split, DeviceListsAreParsedAndChecked) {
+  using app::parse_devices;
+  EXPECT_EQ(parse_devices("all", Backend::Cuda, 2), (std::vector<int>{0, 1}));
+  EXPECT_TRUE(parse_devices("all", Backend::Cpu, 2).empty());
+  EXPECT_EQ(parse_devices("1,0", Backend::Cuda, 2), (std::vector<int>{1, 0}));
+  EXPECT_EQ(parse_devices("0,1,2", Backend::Cpu, 0), (std::vector<int>{0, 1, 2}));
+  for (const char* bad : {"0,", "a", "0;1", "-1", ",0", "0,,1"}) {
+    EXPECT_THROW(parse_devices(bad, Backend::Cpu, 0), SceneError) << bad;
+  }
+  try {
+    parse_devices("0,2", Backend::Cuda, 2);
+    FAIL();
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), "devices: 2 is not a CUDA device (2 present)");
+  }
+}
+
+// On the GPU: the one device named twice runs the split's two workers, each with its
+// own upload and stream of chunks; the image is the one-device image.
+TEST(Split, OneGpuTwiceRendersTheOneGpuImage) {
+  WT_REQUIRE_CUDA();
+  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
+    const RenderResult one = render(quick(), quick_options(Backend::Cuda, k, {0}));
+    const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 0}));
+    // Two devices: ten chunks, the megakernels' ten passes; the same additions.
+    expect_same_image(one, split, k != Kernel::Wavefront, kernel_name(k));
+    ASSERT_EQ(split.shares.size(), 2u);
+    EXPECT_EQ(split.shares[0].samples + split.shares[1].samples, 12);
+  }
+}
+
+// Two GPUs where the machine has them: the split over both is the one-GPU image,
+// and both take part.
+TEST(Split, TwoGpusRenderTheOneGpuImage) {
+  WT_REQUIRE_CUDA();
+  if (cuda::device_count() < 2) GTEST_SKIP() << "one CUDA device: the two-GPU split needs two";
+  for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
+    const RenderResult one = render(quick(), quick_options(Backend::Cuda, k, {0}));
+    const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 1}));
+    expect_same_image(one, split, k != Kernel::Wavefront, kernel_name(k));
+    ASSERT_EQ(split.shares.size(), 2u);
+    EXPECT_GT(split.shares[0].chunks, 0);
+    EXPECT_GT(split.shares[1].chunks, 0);
+  }
+}
+
+}  // namespace
+}  // namespace wt
