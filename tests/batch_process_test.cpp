@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -25,8 +26,8 @@ namespace fs = std::filesystem;
 // Every field of a Job.
 auto fields(const Job& j) {
   return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
-                  j.kernel, j.warmup, j.wave_size, j.threads, j.checkpoint, j.resume, j.checkpoint_every, j.encoding,
-                  j.exr_float, j.progress, j.profile);
+                  j.kernel, j.warmup, j.wave_size, j.threads, j.devices, j.checkpoint, j.resume, j.checkpoint_every,
+                  j.encoding, j.exr_float, j.progress, j.profile);
 }
 
 // Parses a command line (after the program name) as main does.
@@ -58,6 +59,7 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   every.warmup = 3;
   every.wave_size = 4096;
   every.threads = 2;
+  every.devices = "1,0";
   every.checkpoint = "c.ckpt";
   every.resume = "r.ckpt";
   every.checkpoint_every = 9;
@@ -108,10 +110,11 @@ class BatchProcessTest : public testing::Test {
 
   // Runs the batch with the script; its exit code, and what it wrote to stdout and stderr.
   std::tuple<int, std::string, std::string> batch(const std::string& exe, const std::vector<PlannedJob>& list,
-                                                  bool skip_done = false) const {
+                                                  bool skip_done = false,
+                                                  const std::vector<std::string>& lanes = {""}) const {
     testing::internal::CaptureStdout();
     testing::internal::CaptureStderr();
-    const int code = run_batch_in_processes(list, skip_done, exe);
+    const int code = run_batch_in_processes(list, skip_done, exe, lanes);
     std::string out = testing::internal::GetCapturedStdout();
     return {code, out, testing::internal::GetCapturedStderr()};
   }
@@ -180,6 +183,47 @@ for a in "$@"; do case "$a" in --stats=*) printf '%s' '{"settings": {"width": 7,
   EXPECT_NE(out.find("7x5 3spp d2"), std::string::npos) << out;
   EXPECT_NE(out.find("cpu/wavefront"), std::string::npos) << out;
   EXPECT_NE(out.find("    2.000       4.00  ok -> "), std::string::npos) << out;
+}
+
+// Lanes run at once: each job marks that it started and waits (up to 20 s, then
+// fails) until two jobs have, which only jobs running at the same time can do. Each
+// lane's jobs get its devices; the summary lists the jobs in the batch's order.
+TEST_F(BatchProcessTest, LanesRunJobsAtOnceEachOnItsDevices) {
+  const std::string started = (dir_ / "started").string();
+  const std::string exe = script(R"sh(for a in "$@"; do case "$a" in --devices=*) d="${a#--devices=}";; esac; done
+echo "$d" >> ")sh" + (dir_ / "devices").string() + R"sh("
+mkdir -p ")sh" + started + R"sh(" && touch ")sh" + started + R"sh(/$$"
+n=0
+while [ "$(ls ")sh" + started + R"sh(" | wc -l)" -lt 2 ]; do
+  n=$((n + 1)); [ $n -gt 200 ] && { echo "wavetrace: alone" >&2; exit 3; }
+  sleep 0.1
+done
+exit 0)sh");
+  const auto [code, out, err] = batch(exe, jobs(4), false, {"0", "1"});
+  EXPECT_EQ(code, 0) << out << err;
+  EXPECT_NE(out.find("4 jobs: 4 ok, 0 failed"), std::string::npos) << out;
+  for (int i = 1; i <= 4; ++i) {
+    EXPECT_NE(out.find(std::to_string(i) + "    s.json"), std::string::npos) << out;
+  }
+  EXPECT_LT(out.find("1    s.json"), out.find("4    s.json")) << out;
+  std::vector<std::string> devices;
+  std::ifstream in(dir_ / "devices");
+  for (std::string d; std::getline(in, d);) devices.push_back(d);
+  ASSERT_EQ(devices.size(), 4u);
+  EXPECT_EQ(std::count(devices.begin(), devices.end(), "0") + std::count(devices.begin(), devices.end(), "1"), 4);
+  EXPECT_GE(std::count(devices.begin(), devices.end(), "0"), 1);
+  EXPECT_GE(std::count(devices.begin(), devices.end(), "1"), 1);
+}
+
+TEST(BatchLanes, ADeviceEachOrAShareOfThemEach) {
+  EXPECT_EQ(batch_lanes("all", "auto", 16, 2), (std::vector<std::string>{"0", "1"}));
+  EXPECT_EQ(batch_lanes("all", "cuda", 1, 2), (std::vector<std::string>{"0,1"}));
+  EXPECT_EQ(batch_lanes("0,1,2,3", "cuda", 2, 4), (std::vector<std::string>{"0,2", "1,3"}));
+  EXPECT_EQ(batch_lanes("1", "cuda", 5, 2), (std::vector<std::string>{"1"}));
+  EXPECT_EQ(batch_lanes("all", "cuda", 5, 1), (std::vector<std::string>{""}));
+  EXPECT_EQ(batch_lanes("all", "cpu", 5, 2), (std::vector<std::string>{""}));
+  EXPECT_EQ(batch_lanes("all", "auto", 5, 0), (std::vector<std::string>{""}));
+  EXPECT_THROW(batch_lanes("0,7", "cuda", 5, 2), SceneError);
 }
 
 TEST_F(BatchProcessTest, ResumeSkipsJobsWhoseImageExists) {

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <mutex>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "app/cli.hpp"
@@ -113,62 +115,92 @@ namespace {
 using JobRunner = std::function<JobOutcome(size_t index, const Job& job)>;
 
 // The batch loop and its summary, whichever way the jobs run. `signal_caught`: a
-// signal the batch itself caught (0: none), which stops it after the job it ran.
+// signal the batch itself caught (0: none), which stops it after the jobs it runs.
+// `lanes`: the jobs run in as many lanes at once, each lane's CUDA jobs on its
+// devices ("" : the job's own); the summary lists them in the batch's order.
 int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunner& run,
-             const std::function<int()>& signal_caught) {
+             const std::function<int()>& signal_caught, const std::vector<std::string>& lanes = {""}) {
   struct Row {
+    bool done = false;
     std::string scene, settings, kernel, status;
     double seconds = 0, mrays = 0;
   };
-  std::vector<Row> rows;
+  std::vector<Row> rows(jobs.size());
   int failed = 0, interrupted = 0;
-  for (size_t i = 0; i < jobs.size() && !interrupted; ++i) {
-    const PlannedJob& pj = jobs[i];
-    std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, jobs.size(), pj.job.scene.c_str());
-    Row row;
-    row.scene = pj.job.scene;
-    row.kernel = pj.job.kernel;
-    // Images are written through a temporary file renamed into place: one that
-    // exists is complete.
-    if (skip_done && pj.error.empty() && std::filesystem::exists(pj.job.output)) {
-      row.status = "skipped: " + pj.job.output + " exists";
-      rows.push_back(row);
-      continue;
+  size_t next = 0, run_count = 0;
+  std::mutex m;
+  auto lane = [&](const std::string& devices) {
+    for (;;) {
+      size_t i;
+      {
+        std::lock_guard<std::mutex> lock(m);
+        if (interrupted || next >= jobs.size()) return;
+        i = next++;
+        std::fprintf(stderr, "[%zu/%zu] %s%s\n", i + 1, jobs.size(), jobs[i].job.scene.c_str(),
+                     devices.empty() ? "" : (" on cuda " + devices).c_str());
+      }
+      const PlannedJob& pj = jobs[i];
+      Row row;
+      row.done = true;
+      row.scene = pj.job.scene;
+      row.kernel = pj.job.kernel;
+      // Images are written through a temporary file renamed into place: one that
+      // exists is complete.
+      if (skip_done && pj.error.empty() && std::filesystem::exists(pj.job.output)) {
+        row.status = "skipped: " + pj.job.output + " exists";
+        std::lock_guard<std::mutex> lock(m);
+        rows[i] = row;
+        ++run_count;
+        continue;
+      }
+      JobOutcome o;
+      if (!pj.error.empty()) {
+        o.exit_code = kExitBadInput;
+        o.message = pj.error;
+      } else {
+        Job job = pj.job;
+        if (!devices.empty() && job.backend != "cpu") job.devices = devices;
+        if (lanes.size() > 1) job.progress = false;  // one line per job, not interleaved progress
+        o = run(i, job);
+      }
+      if (o.exit_code != 0) {
+        row.status = "FAILED: " + o.message;
+        std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
+      } else {
+        row.status = "ok -> " + pj.job.output;
+        row.kernel = o.backend + "/" + o.kernel;
+        row.settings = std::to_string(o.params.width) + "x" + std::to_string(o.params.height) + " " +
+                       std::to_string(o.params.spp) + "spp d" + std::to_string(o.params.depth);
+        row.seconds = o.result.seconds;
+        row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
+      }
+      std::lock_guard<std::mutex> lock(m);
+      rows[i] = row;
+      ++run_count;
+      if (o.exit_code != 0) ++failed;
+      // A signal stopped the job (after its last checkpoint), or reached the batch
+      // while the job ran: the batch stops too, after the jobs running finish.
+      if (o.exit_code >= 128 && !interrupted) interrupted = o.exit_code;
+      if (const int sig = signal_caught ? signal_caught() : 0; sig != 0 && !interrupted) interrupted = 128 + sig;
     }
-    JobOutcome o;
-    if (!pj.error.empty()) {
-      o.exit_code = kExitBadInput;
-      o.message = pj.error;
-    } else {
-      o = run(i, pj.job);
-    }
-    if (o.exit_code != 0) {
-      ++failed;
-      row.status = "FAILED: " + o.message;
-      std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
-    } else {
-      row.status = "ok -> " + pj.job.output;
-      row.kernel = o.backend + "/" + o.kernel;
-      row.settings = std::to_string(o.params.width) + "x" + std::to_string(o.params.height) + " " +
-                     std::to_string(o.params.spp) + "spp d" + std::to_string(o.params.depth);
-      row.seconds = o.result.seconds;
-      row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
-    }
-    rows.push_back(row);
-    // A signal stopped the job (after its last checkpoint), or reached the batch
-    // while the job ran: the batch stops too.
-    if (o.exit_code >= 128) interrupted = o.exit_code;
-    if (const int sig = signal_caught ? signal_caught() : 0; sig != 0 && !interrupted) interrupted = 128 + sig;
+  };
+  if (lanes.size() <= 1) {
+    lane(lanes.empty() ? std::string() : lanes[0]);
+  } else {
+    std::vector<std::thread> threads;
+    for (const std::string& devices : lanes) threads.emplace_back(lane, devices);
+    for (std::thread& t : threads) t.join();
   }
   std::printf("%-4s %-32s %-22s %-26s %9s %10s  %s\n", "job", "scene", "settings", "backend/kernel", "seconds",
               "M rays/s", "result");
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
+    if (!r.done) continue;
     std::printf("%-4zu %-32s %-22s %-26s %9.3f %10.2f  %s\n", i + 1, r.scene.c_str(), r.settings.c_str(),
                 r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
   }
-  std::printf("%zu jobs: %zu ok, %d failed", rows.size(), rows.size() - failed, failed);
-  if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - rows.size());
+  std::printf("%zu jobs: %zu ok, %d failed", run_count, run_count - failed, failed);
+  if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - run_count);
   std::printf("\n");
   std::fflush(stdout);
   if (interrupted) return interrupted;
@@ -251,12 +283,29 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
   return run_jobs(jobs, skip_done, run, nullptr);
 }
 
-int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable) {
+std::vector<std::string> batch_lanes(const std::string& devices, const std::string& backend, size_t jobs,
+                                     int present) {
+  if (backend == "cpu" || present == 0 || jobs == 0) return {""};
+  const std::vector<int> list = parse_devices(devices, Backend::Cuda, present);
+  if (list.size() <= 1) return {devices == "all" ? "" : devices};
+  // A lane per device; with fewer jobs than devices, a lane per job, each over its
+  // share of the devices.
+  const size_t lanes = std::min(list.size(), jobs);
+  std::vector<std::string> out(lanes);
+  for (size_t i = 0; i < list.size(); ++i) {
+    std::string& lane = out[i % lanes];
+    lane += (lane.empty() ? "" : ",") + std::to_string(list[i]);
+  }
+  return out;
+}
+
+int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
+                           const std::vector<std::string>& lanes) {
   const SignalForwarder signals;
   const JobRunner run = [&](size_t index, const Job& job) {
     return run_job_in_process(executable, index, job, signals);
   };
-  return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); });
+  return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes);
 }
 
 }  // namespace wt::app

@@ -33,6 +33,15 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
 // own, or a temporary one removed after it). SIGINT and SIGTERM sent to this process
 // are passed on to the running job, and the batch stops after it with 128 + the
 // signal; a job killed by another signal fails alone. This process never calls CUDA.
-int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable);
+// The lanes a batch runs its jobs in at once (run_batch_in_processes): one per CUDA
+// device of `devices` ("all" or a list; `present` devices), or with fewer jobs than
+// devices one per job, each over its share of them; a single lane ("": the jobs'
+// own devices) on the CPU backend or with one device. Throws SceneError for a bad list.
+std::vector<std::string> batch_lanes(const std::string& devices, const std::string& backend, size_t jobs,
+                                     int present);
+
+// Runs each job as `wavetrace render` in a process of its own, the lanes' jobs at once.
+int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
+                           const std::vector<std::string>& lanes = {""});
 
 }  // namespace wt::app

@@ -7,6 +7,7 @@
 #include "app/bench.hpp"
 #include "app/cli.hpp"
 #include "app/job.hpp"
+#include "cuda/device.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
@@ -108,6 +109,14 @@ int main(int argc, char** argv) {
     return wt::app::kExitBadInput;
   }
   // Each job runs as `wavetrace render` in a process of its own: a clean CUDA context
-  // for every job, whatever the one before it did to its own.
-  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe");
+  // for every job, whatever the one before it did to its own. With several CUDA
+  // devices the jobs run at once, a device (or a share of them) each.
+  std::vector<std::string> lanes;
+  try {
+    lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, jobs.size(), wt::cuda::device_count());
+  } catch (const wt::SceneError& e) {
+    std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    return wt::app::kExitBadInput;
+  }
+  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes);
 }

@@ -9,7 +9,9 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
+#include <string>
 
 extern char** environ;
 
@@ -18,16 +20,39 @@ namespace wt::app {
 namespace {
 
 volatile std::sig_atomic_t g_caught = 0;
-volatile std::sig_atomic_t g_forwarded = 0;  // g_caught was passed on to g_child
-volatile pid_t g_child = 0;
+// The children running (a batch runs several at once), each in a slot: its pid (0:
+// free), and whether g_caught was passed on to it.
+constexpr int kMaxChildren = 64;
+volatile pid_t g_children[kMaxChildren] = {};
+volatile std::sig_atomic_t g_forwarded[kMaxChildren] = {};
+std::mutex g_slots;
+bool g_slot_taken[kMaxChildren] = {};
 
 void forward(int sig) {
   g_caught = sig;
-  const pid_t child = g_child;
-  if (child > 0) {
-    ::kill(child, sig);
-    g_forwarded = 1;
+  for (int i = 0; i < kMaxChildren; ++i) {
+    const pid_t child = g_children[i];
+    if (child > 0) {
+      ::kill(child, sig);
+      g_forwarded[i] = 1;
+    }
   }
+}
+
+int take_slot() {
+  std::lock_guard<std::mutex> lock(g_slots);
+  for (int i = 0; i < kMaxChildren; ++i) {
+    if (!g_slot_taken[i]) {
+      g_slot_taken[i] = true;
+      return i;
+    }
+  }
+  throw std::runtime_error("more than " + std::to_string(kMaxChildren) + " jobs at once");
+}
+
+void free_slot(int slot) {
+  std::lock_guard<std::mutex> lock(g_slots);
+  g_slot_taken[slot] = false;
 }
 
 struct sigaction g_previous_int {}, g_previous_term {};
@@ -49,16 +74,19 @@ sigset_t int_and_term() {
   return both;
 }
 
-// Sets the child that signals go to (0: none), and passes on one caught before it was
-// known. The two signals are blocked meanwhile, so that none is passed on twice.
-void set_child(pid_t pid) {
+// Sets the child of `slot` that signals go to (0: none), and passes on one caught
+// before it was known. The two signals are blocked in this thread meanwhile; one
+// that another thread takes meanwhile may reach the child twice, which a render
+// answers as once.
+void set_child(int slot, pid_t pid) {
   const sigset_t both = int_and_term();
   sigset_t previous;
   pthread_sigmask(SIG_BLOCK, &both, &previous);
-  g_child = pid;
-  if (pid > 0 && g_caught != 0 && !g_forwarded) {
+  if (pid == 0) g_forwarded[slot] = 0;
+  g_children[slot] = pid;
+  if (pid > 0 && g_caught != 0 && !g_forwarded[slot]) {
     ::kill(pid, g_caught);
-    g_forwarded = 1;
+    g_forwarded[slot] = 1;
   }
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
 }
@@ -113,8 +141,10 @@ class StderrFilter {
 
 SignalForwarder::SignalForwarder() {
   g_caught = 0;
-  g_forwarded = 0;
-  g_child = 0;
+  for (int i = 0; i < kMaxChildren; ++i) {
+    g_forwarded[i] = 0;
+    g_children[i] = 0;
+  }
   catch_unless_ignored(SIGINT, g_previous_int);
   catch_unless_ignored(SIGTERM, g_previous_term);
 }
@@ -152,7 +182,8 @@ ChildEnd run_child(const std::string& executable, const std::vector<std::string>
     ::close(fds[0]);
     throw std::runtime_error("cannot start " + executable + ": " + std::strerror(err));
   }
-  set_child(pid);
+  const int slot = take_slot();
+  set_child(slot, pid);
 
   StderrFilter filter;
   char buf[4096];
@@ -164,7 +195,8 @@ ChildEnd run_child(const std::string& executable, const std::vector<std::string>
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  set_child(0);
+  set_child(slot, 0);
+  free_slot(slot);
 
   ChildEnd end;
   end.last_line = filter.finish();
