@@ -69,6 +69,7 @@ class DeviceFaults : public testing::Test {
     j.output = path(output);
     j.backend = "cuda";
     j.kernel = kernel;
+    j.devices = "0";  // the device whose context the tests poison (a split would use the others too)
     j.width = 32;
     j.height = 16;
     j.spp = 4;

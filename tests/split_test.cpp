@@ -10,6 +10,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/job.hpp"
@@ -141,13 +142,25 @@ TEST(Split, AFailingDeviceFailsTheRenderAndSaysWhich) {
   } catch (const DeviceError& e) {
     EXPECT_EQ(std::string(e.what()), "gpu:2: out of device memory");
   }
+  // Device 1's first chunk fails; device 0 waits for that before it finishes its
+  // own, so that it cannot take every chunk first.
+  std::atomic<bool> failed{false};
   auto bad_chunk = [&](size_t d) -> ChunkRenderer {
-    return [d](const RenderOptions&) -> RenderResult {
-      if (d == 1) throw SceneError("width x height: too large for this device");
-      return RenderResult{};
+    return [d, &o, &failed](const RenderOptions&) -> RenderResult {
+      if (d == 1) {
+        failed = true;
+        throw SceneError("width x height: too large for this device");
+      }
+      while (!failed) std::this_thread::yield();
+      RenderResult r;
+      r.rgb.assign(static_cast<size_t>(o.params.width) * o.params.height * 3, 0.0f);
+      return r;
     };
   };
   EXPECT_THROW(render_split(o, {"gpu:0", "gpu:1"}, bad_chunk), SceneError);
+  // A chunk whose film has the wrong size is the device's failure, not a crash.
+  auto short_film = [](size_t) -> ChunkRenderer { return [](const RenderOptions&) { return RenderResult{}; }; };
+  EXPECT_THROW(render_split(o, {"gpu:0"}, short_film), DeviceError);
 }
 
 TEST(Split, DeviceListsAreParsedAndChecked) {

@@ -134,6 +134,10 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         chunk.first_sample = chunks[c].first;
         chunk.sample_count = chunks[c].count;
         RenderResult r = render_chunk(chunk);
+        if (r.rgb.size() != floats) {
+          throw DeviceError("a chunk came back with " + std::to_string(r.rgb.size()) + " film values, not " +
+                            std::to_string(floats));
+        }
         std::lock_guard<std::mutex> lock(m);
         DeviceShare& share = out.shares[d];
         share.samples += chunks[c].count;
