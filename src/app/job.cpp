@@ -4,6 +4,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <thread>
@@ -170,7 +171,13 @@ JobOutcome run_job(const Job& job) {
     if (!job.stats.empty()) check_output_path_for_text(job.stats);
     // The CUDA context starts while the scene loads.
     std::thread context;
-    if (job.backend != "cpu") context = std::thread(cuda::start_context);
+    // (That of the first device named, where the job names its devices: a batch
+    // lane's job starts no context on another lane's device.)
+    int first_device = 0;
+    if (job.devices != "all" && !job.devices.empty() && job.devices[0] >= '0' && job.devices[0] <= '9') {
+      first_device = std::atoi(job.devices.c_str());
+    }
+    if (job.backend != "cpu") context = std::thread(cuda::start_context, first_device);
     struct Joined {
       std::thread& t;
       ~Joined() {

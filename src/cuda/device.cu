@@ -23,8 +23,9 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 
 }  // namespace
 
-void start_context() {
-  if (device_count() > 0 && cudaFree(nullptr) != cudaSuccess) cudaGetLastError();
+void start_context(int device) {
+  if (device_count() <= device) return;
+  if (cudaSetDevice(device) != cudaSuccess || cudaFree(nullptr) != cudaSuccess) cudaGetLastError();
 }
 
 void check(int code, const char* call, const char* stage) {

@@ -20,7 +20,8 @@ int device_count();
 // Starts the CUDA runtime and the current device's context, which takes a good
 // part of a second, so that it can run while a scene loads. Quiet where there is no
 // device: the render that needs one says so.
-void start_context();
+// `device`: the device whose context to start (the first the job renders on).
+void start_context(int device = 0);
 
 struct DeviceInfo {
   std::string name;
