@@ -4,7 +4,6 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <thread>
@@ -16,6 +15,7 @@
 #include "app/signals.hpp"
 #include "app/stats.hpp"
 #include "cuda/device.hpp"
+#include "render/split.hpp"
 
 namespace wt::app {
 
@@ -47,13 +47,10 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
     if (!digits) {
       throw SceneError("devices: '" + text + "' is not 'all' or a list of device indices such as 0,1");
     }
-    const int d = std::stoi(item);
-    if (backend == Backend::Cuda && d >= present) {
-      throw SceneError("devices: " + item + " is not a CUDA device (" + std::to_string(present) + " present)");
-    }
-    out.push_back(d);
+    out.push_back(std::stoi(item));
     at = comma + 1;
   }
+  if (backend == Backend::Cuda) require_cuda_devices(out, present);
   return out;
 }
 
@@ -169,15 +166,21 @@ JobOutcome run_job(const Job& job) {
   try {
     check_output_path(job.output);
     if (!job.stats.empty()) check_output_path_for_text(job.stats);
-    // The CUDA context starts while the scene loads.
+    // The CUDA context starts while the scene loads: that of the first device the job
+    // renders on (a batch lane's job starts none on another lane's device). A bad
+    // device list is left for the render's own parse below to report.
     std::thread context;
-    // (That of the first device named, where the job names its devices: a batch
-    // lane's job starts no context on another lane's device.)
-    int first_device = 0;
-    if (job.devices != "all" && !job.devices.empty() && job.devices[0] >= '0' && job.devices[0] <= '9') {
-      first_device = std::atoi(job.devices.c_str());
+    if (job.backend != "cpu") {
+      context = std::thread([&job] {
+        int first = 0;
+        try {
+          const std::vector<int> devices = parse_devices(job.devices, Backend::Cuda, cuda::device_count());
+          if (!devices.empty()) first = devices[0];
+        } catch (const SceneError&) {
+        }
+        cuda::start_context(first);
+      });
     }
-    if (job.backend != "cpu") context = std::thread(cuda::start_context, first_device);
     struct Joined {
       std::thread& t;
       ~Joined() {

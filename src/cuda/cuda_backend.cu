@@ -146,12 +146,7 @@ class Uploaded {
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const int present = device_count();
   if (present == 0) throw DeviceError("backend: cuda was asked for, but no CUDA device is present");
-  for (int d : options.devices) {
-    if (d < 0 || d >= present) {
-      throw SceneError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
-                       " present: 0.." + std::to_string(present - 1) + ")");
-    }
-  }
+  require_cuda_devices(options.devices, present);
   if (options.devices.size() > 1) {
     std::vector<std::string> labels;
     for (int d : options.devices) labels.push_back("cuda:" + std::to_string(d));

@@ -29,6 +29,18 @@ constexpr int kChunksPerDevice = 4;
 // devices the chunks are its passes, and its image is the same to the bit.
 constexpr int kMinChunks = 10;
 
+// Throws SceneError naming the first index that is not one of the `present` CUDA
+// devices (0..present-1): the one check of a device list, from the command line or
+// from a caller's options.
+inline void require_cuda_devices(const std::vector<int>& devices, int present) {
+  for (int d : devices) {
+    if (d < 0 || d >= present) {
+      throw SceneError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
+                       " present)");
+    }
+  }
+}
+
 // What renders one device's chunks: made on that device's own thread (where it may
 // upload the scene), then called with each chunk's options, returning the chunk's
 // pixel sums (Radiance::SumOfSamples) and its counts.
