@@ -1,6 +1,7 @@
 // Checkpoints: the file round-trips, a damaged or foreign one is refused with one
 // line, and a render stopped by a signal resumes to the image it would have made.
 #include <gtest/gtest.h>
+#include <pthread.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -146,15 +147,18 @@ TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
   const JobOutcome whole = run_job(job(path("whole.pfm")));
   ASSERT_EQ(whole.exit_code, 0) << whole.message;
 
-  // A SIGTERM is pending (blocked) when the render starts: the job's catcher takes
-  // it, so the render stops after its first pass with a last checkpoint.
+  // A SIGTERM is pending (blocked) on this thread when the render starts: the job's
+  // catcher takes it, so the render stops after its first pass with a last
+  // checkpoint. The signal is sent to this thread alone: one sent to the process
+  // would go to any other thread that does not block it (the CUDA driver's), and
+  // end the process before the catcher is there.
   Job first = job(path("resumed.pfm"));
   first.checkpoint = path("r.ckpt");
   sigset_t term, previous;
   sigemptyset(&term);
   sigaddset(&term, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &term, &previous);
-  ::kill(::getpid(), SIGTERM);
+  ::pthread_kill(::pthread_self(), SIGTERM);
   const JobOutcome stopped = run_job(first);
   pthread_sigmask(SIG_SETMASK, &previous, nullptr);
   EXPECT_EQ(stopped.exit_code, 128 + SIGTERM);
