@@ -8,11 +8,13 @@ bash "$root/scripts/build.sh"
 mkdir -p "$root/.gpu/bin"
 cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$root/.gpu/bin/"
 # The shared libraries they load (OpenEXR's family, the C++ runtime it needs) beside
-# them in lib/, where their RPATH looks first; glibc itself is the GPU machine's.
+# them in lib/, where their RPATH looks first; glibc itself is the GPU machine's, and
+# so is Open MPI (its mpirun and libmpi.so.40 must be one installation).
 rm -rf "$root/.gpu/bin/lib" && mkdir -p "$root/.gpu/bin/lib"
 for b in "$root/.gpu/bin/wavetrace" "$root/.gpu/bin"/*_tests; do ldd "$b"; done |
   awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |
   grep -vE '/(libc|libm|libpthread|libdl|librt|libresolv|ld-linux[^/]*)\.so' |
+  grep -vE '/lib(mpi|open-pal|open-rte|hwloc|event[^/]*|udev|pmix)\.so' |
   xargs -r cp -L -t "$root/.gpu/bin/lib"
 commit=$(git -C "$root" rev-parse HEAD)
 dirty=$(git -C "$root" status --porcelain --untracked-files=no | grep -q . && echo true || echo false)

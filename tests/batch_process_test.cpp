@@ -30,18 +30,6 @@ auto fields(const Job& j) {
                   j.encoding, j.exr_float, j.progress, j.profile);
 }
 
-// Parses a command line (after the program name) as main does.
-Job parse_render(const std::vector<std::string>& args) {
-  CLI::App app;
-  RenderCommand cmd;
-  add_render_command(app, cmd);
-  std::vector<std::string> text = {"wavetrace"};
-  text.insert(text.end(), args.begin(), args.end());
-  std::vector<const char*> argv;
-  for (const std::string& a : text) argv.push_back(a.c_str());
-  app.parse(static_cast<int>(argv.size()), argv.data());
-  return cmd.parsed();
-}
 
 TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   Job every;
@@ -73,17 +61,17 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   for (const Job& job : {every, defaults}) {
     const std::vector<std::string> args = render_arguments(job);
     EXPECT_EQ(args.front(), "render");
-    const Job back = parse_render(args);
+    const Job back = parse_render_arguments(args);
     EXPECT_TRUE(fields(back) == fields(job)) << job.scene;
   }
   // A default job's settings stay unset, so that the scene's own apply.
-  EXPECT_FALSE(parse_render({"render", "-o", "o.png", "s.json"}).width.has_value());
+  EXPECT_FALSE(parse_render_arguments({"render", "-o", "o.png", "s.json"}).width.has_value());
 }
 
 TEST(RenderCommand, ExrFloatIsAFlagThatIsOffByDefault) {
-  EXPECT_TRUE(parse_render({"render", "-o", "o.exr", "--exr-float", "s.json"}).exr_float);
-  EXPECT_FALSE(parse_render({"render", "-o", "o.exr", "s.json"}).exr_float);
-  EXPECT_THROW(parse_render({"render", "-o", "o.exr", "--exr-float=maybe", "s.json"}), CLI::ParseError);
+  EXPECT_TRUE(parse_render_arguments({"render", "-o", "o.exr", "--exr-float", "s.json"}).exr_float);
+  EXPECT_FALSE(parse_render_arguments({"render", "-o", "o.exr", "s.json"}).exr_float);
+  EXPECT_THROW(parse_render_arguments({"render", "-o", "o.exr", "--exr-float=maybe", "s.json"}), CLI::ParseError);
 }
 
 class BatchProcessTest : public testing::Test {

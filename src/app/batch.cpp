@@ -9,10 +9,12 @@
 #include <fstream>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <nlohmann/json.hpp>
 
 #include "app/cli.hpp"
+#include "app/distributed.hpp"
 #include "app/process.hpp"
 #include "app/signals.hpp"
 
@@ -114,97 +116,145 @@ namespace {
 // Runs one job of a batch: its outcome, whose message the batch prints.
 using JobRunner = std::function<JobOutcome(size_t index, const Job& job)>;
 
+// The job as a lane runs it: on the lane's CUDA devices ("": the job's own), without
+// a progress line where lanes run at once.
+Job lane_job(Job job, const std::string& devices, bool quiet) {
+  if (!devices.empty() && job.backend != "cpu") job.devices = devices;
+  if (quiet) job.progress = false;
+  return job;
+}
+
+// One run of a batch: which job comes next, what each did, and the summary. Its lanes
+// (threads of this process, and an MPI run's other ranks) take jobs as they free up.
+class BatchRun {
+ public:
+  BatchRun(const std::vector<PlannedJob>& jobs, bool skip_done, std::function<int()> signal_caught)
+      : jobs_(jobs), skip_done_(skip_done), signal_caught_(std::move(signal_caught)), rows_(jobs.size()) {}
+
+  // The next job to run, said on its line with where it runs; none when every job is
+  // taken or the batch was interrupted.
+  std::optional<size_t> take(const std::string& where) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (interrupted_ || next_ >= jobs_.size()) return std::nullopt;
+    const size_t i = next_++;
+    std::fprintf(stderr, "[%zu/%zu] %s%s\n", i + 1, jobs_.size(), jobs_[i].job.scene.c_str(),
+                 where.empty() ? "" : (" on " + where).c_str());
+    return i;
+  }
+
+  // Settles job i where it needs no render: skipped (its image exists, the batch being
+  // resumed; images are written through a temporary file renamed into place, so one
+  // that exists is complete), or refused when it was read. True if settled.
+  bool settle(size_t i) {
+    const PlannedJob& pj = jobs_[i];
+    if (skip_done_ && pj.error.empty() && std::filesystem::exists(pj.job.output)) {
+      Row row = row_of(pj);
+      row.status = "skipped: " + pj.job.output + " exists";
+      std::lock_guard<std::mutex> lock(m_);
+      rows_[i] = row;
+      ++run_count_;
+      return true;
+    }
+    if (pj.error.empty()) return false;
+    JobOutcome o;
+    o.exit_code = kExitBadInput;
+    o.message = pj.error;
+    record(i, o);
+    return true;
+  }
+
+  void record(size_t i, const JobOutcome& o) {
+    const PlannedJob& pj = jobs_[i];
+    Row row = row_of(pj);
+    if (o.exit_code != 0) {
+      row.status = "FAILED: " + o.message;
+      std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
+    } else {
+      row.status = "ok -> " + pj.job.output;
+      row.kernel = o.backend + "/" + o.kernel;
+      row.settings = std::to_string(o.params.width) + "x" + std::to_string(o.params.height) + " " +
+                     std::to_string(o.params.spp) + "spp d" + std::to_string(o.params.depth);
+      row.seconds = o.result.seconds;
+      row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
+    }
+    std::lock_guard<std::mutex> lock(m_);
+    rows_[i] = row;
+    ++run_count_;
+    if (o.exit_code != 0) ++failed_;
+    // A signal stopped the job (after its last checkpoint), or reached the batch
+    // while the job ran: the batch stops too, after the jobs running finish.
+    if (o.exit_code >= 128 && !interrupted_) interrupted_ = o.exit_code;
+    if (const int sig = signal_caught_ ? signal_caught_() : 0; sig != 0 && !interrupted_) interrupted_ = 128 + sig;
+  }
+
+  // A lane of this process: runs jobs with `run` until none is left. `devices`: the
+  // lane's CUDA devices ("": the job's own); `quiet`: no progress lines (lanes at once).
+  void lane(const JobRunner& run, const std::string& devices, bool quiet) {
+    while (const std::optional<size_t> i = take(devices.empty() ? "" : "cuda " + devices)) {
+      if (settle(*i)) continue;
+      record(*i, run(*i, lane_job(jobs_[*i].job, devices, quiet)));
+    }
+  }
+
+  // Prints the summary table and the count line; the batch's exit code.
+  int summary() const {
+    std::printf("%-4s %-32s %-22s %-26s %9s %10s  %s\n", "job", "scene", "settings", "backend/kernel", "seconds",
+                "M rays/s", "result");
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      const Row& r = rows_[i];
+      if (!r.done) continue;
+      std::printf("%-4zu %-32s %-22s %-26s %9.3f %10.2f  %s\n", i + 1, r.scene.c_str(), r.settings.c_str(),
+                  r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
+    }
+    std::printf("%zu jobs: %zu ok, %d failed", run_count_, run_count_ - failed_, failed_);
+    if (interrupted_) std::printf("; interrupted, %zu not run", jobs_.size() - run_count_);
+    std::printf("\n");
+    std::fflush(stdout);
+    if (interrupted_) return interrupted_;
+    return failed_ ? kExitFailure : 0;
+  }
+
+  const Job& job(size_t i) const { return jobs_[i].job; }
+
+ private:
+  struct Row {
+    bool done = false;
+    std::string scene, settings, kernel, status;
+    double seconds = 0, mrays = 0;
+  };
+
+  static Row row_of(const PlannedJob& pj) {
+    Row row;
+    row.done = true;
+    row.scene = pj.job.scene;
+    row.kernel = pj.job.kernel;
+    return row;
+  }
+
+  const std::vector<PlannedJob>& jobs_;
+  const bool skip_done_;
+  const std::function<int()> signal_caught_;
+  std::mutex m_;
+  std::vector<Row> rows_;
+  size_t next_ = 0, run_count_ = 0;
+  int failed_ = 0, interrupted_ = 0;
+};
+
 // The batch loop and its summary, whichever way the jobs run. `signal_caught`: a
 // signal the batch itself caught (0: none), which stops it after the jobs it runs.
 // `lanes`: the jobs run in as many lanes at once, each lane's CUDA jobs on its
 // devices ("" : the job's own); the summary lists them in the batch's order.
 int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunner& run,
              const std::function<int()>& signal_caught, const std::vector<std::string>& lanes = {""}) {
-  struct Row {
-    bool done = false;
-    std::string scene, settings, kernel, status;
-    double seconds = 0, mrays = 0;
-  };
-  std::vector<Row> rows(jobs.size());
-  int failed = 0, interrupted = 0;
-  size_t next = 0, run_count = 0;
-  std::mutex m;
-  auto lane = [&](const std::string& devices) {
-    for (;;) {
-      size_t i;
-      {
-        std::lock_guard<std::mutex> lock(m);
-        if (interrupted || next >= jobs.size()) return;
-        i = next++;
-        std::fprintf(stderr, "[%zu/%zu] %s%s\n", i + 1, jobs.size(), jobs[i].job.scene.c_str(),
-                     devices.empty() ? "" : (" on cuda " + devices).c_str());
-      }
-      const PlannedJob& pj = jobs[i];
-      Row row;
-      row.done = true;
-      row.scene = pj.job.scene;
-      row.kernel = pj.job.kernel;
-      // Images are written through a temporary file renamed into place: one that
-      // exists is complete.
-      if (skip_done && pj.error.empty() && std::filesystem::exists(pj.job.output)) {
-        row.status = "skipped: " + pj.job.output + " exists";
-        std::lock_guard<std::mutex> lock(m);
-        rows[i] = row;
-        ++run_count;
-        continue;
-      }
-      JobOutcome o;
-      if (!pj.error.empty()) {
-        o.exit_code = kExitBadInput;
-        o.message = pj.error;
-      } else {
-        Job job = pj.job;
-        if (!devices.empty() && job.backend != "cpu") job.devices = devices;
-        if (lanes.size() > 1) job.progress = false;  // one line per job, not interleaved progress
-        o = run(i, job);
-      }
-      if (o.exit_code != 0) {
-        row.status = "FAILED: " + o.message;
-        std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
-      } else {
-        row.status = "ok -> " + pj.job.output;
-        row.kernel = o.backend + "/" + o.kernel;
-        row.settings = std::to_string(o.params.width) + "x" + std::to_string(o.params.height) + " " +
-                       std::to_string(o.params.spp) + "spp d" + std::to_string(o.params.depth);
-        row.seconds = o.result.seconds;
-        row.mrays = o.result.seconds > 0 ? o.result.rays / o.result.seconds / 1e6 : 0;
-      }
-      std::lock_guard<std::mutex> lock(m);
-      rows[i] = row;
-      ++run_count;
-      if (o.exit_code != 0) ++failed;
-      // A signal stopped the job (after its last checkpoint), or reached the batch
-      // while the job ran: the batch stops too, after the jobs running finish.
-      if (o.exit_code >= 128 && !interrupted) interrupted = o.exit_code;
-      if (const int sig = signal_caught ? signal_caught() : 0; sig != 0 && !interrupted) interrupted = 128 + sig;
-    }
-  };
+  BatchRun batch(jobs, skip_done, signal_caught);
   if (lanes.size() <= 1) {
-    lane(lanes.empty() ? std::string() : lanes[0]);
+    batch.lane(run, lanes.empty() ? std::string() : lanes[0], false);
   } else {
     std::vector<std::thread> threads;
-    for (const std::string& devices : lanes) threads.emplace_back(lane, devices);
+    for (const std::string& devices : lanes) threads.emplace_back([&, devices] { batch.lane(run, devices, true); });
     for (std::thread& t : threads) t.join();
   }
-  std::printf("%-4s %-32s %-22s %-26s %9s %10s  %s\n", "job", "scene", "settings", "backend/kernel", "seconds",
-              "M rays/s", "result");
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Row& r = rows[i];
-    if (!r.done) continue;
-    std::printf("%-4zu %-32s %-22s %-26s %9.3f %10.2f  %s\n", i + 1, r.scene.c_str(), r.settings.c_str(),
-                r.kernel.c_str(), r.seconds, r.mrays, r.status.c_str());
-  }
-  std::printf("%zu jobs: %zu ok, %d failed", run_count, run_count - failed, failed);
-  if (interrupted) std::printf("; interrupted, %zu not run", jobs.size() - run_count);
-  std::printf("\n");
-  std::fflush(stdout);
-  if (interrupted) return interrupted;
-  return failed ? kExitFailure : 0;
+  return batch.summary();
 }
 
 // What a job's stats file says about its render, for the summary.
@@ -284,10 +334,15 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
 }
 
 std::vector<std::string> batch_lanes(const std::string& devices, const std::string& backend, size_t jobs,
-                                     int present) {
+                                     int present, const Cluster& cluster) {
   if (backend == "cpu" || present == 0 || jobs == 0) return {""};
-  const std::vector<int> list = parse_devices(devices, Backend::Cuda, present);
-  if (list.size() <= 1) return {devices == "all" ? "" : devices};
+  // The ranks of an MPI run on one host share its GPUs out.
+  const std::vector<int> list =
+      local_share(parse_devices(devices, Backend::Cuda, present), cluster.local_rank(), cluster.local_ranks());
+  if (list.size() <= 1) {
+    if (cluster.local_ranks() > 1 && list.size() == 1) return {std::to_string(list[0])};
+    return {devices == "all" ? "" : devices};
+  }
   // A lane per device; with fewer jobs than devices, a lane per job, each over its
   // share of the devices.
   const size_t lanes = std::min(list.size(), jobs);
@@ -299,13 +354,114 @@ std::vector<std::string> batch_lanes(const std::string& devices, const std::stri
   return out;
 }
 
+namespace {
+
+// What a rank's lane says of the job it ran, and rank 0 reads back.
+json outcome_json(size_t index, const JobOutcome& o) {
+  return json{{"index", index},        {"exit_code", o.exit_code},        {"message", o.message},
+              {"backend", o.backend},  {"kernel", o.kernel},              {"width", o.params.width},
+              {"height", o.params.height}, {"spp", o.params.spp},         {"depth", o.params.depth},
+              {"seconds", o.result.seconds}, {"rays", o.result.rays}};
+}
+
+JobOutcome outcome_of(const json& j) {
+  JobOutcome o;
+  o.exit_code = j.value("exit_code", kExitFailure);
+  o.message = j.value("message", "");
+  o.backend = j.value("backend", "");
+  o.kernel = j.value("kernel", "");
+  o.params.width = j.value("width", 0);
+  o.params.height = j.value("height", 0);
+  o.params.spp = j.value("spp", 0);
+  o.params.depth = j.value("depth", 0);
+  o.result.seconds = j.value("seconds", 0.0);
+  o.result.rays = j.value("rays", uint64_t(0));
+  return o;
+}
+
+// Rank 0 of an MPI batch, on its main thread while its own lanes run: answers the
+// other ranks' lanes, each asking for a job with what its last one did, until every
+// one has been told that none is left.
+void serve_ranks(const Cluster& cluster, BatchRun& batch, size_t remote_lanes) {
+  while (remote_lanes > 0) {
+    const ClusterMessage m = cluster.receive_any();
+    const json said = json::parse(m.text);
+    if (said.contains("index")) batch.record(said["index"].get<size_t>(), outcome_of(said));
+    const std::string where = "rank " + std::to_string(m.from) + " (" + said.value("host", "") + ")" +
+                              (said.value("devices", "").empty() ? "" : " cuda " + said.value("devices", ""));
+    std::optional<size_t> i;
+    while ((i = batch.take(where)) && batch.settle(*i)) {
+    }
+    if (!i) {
+      cluster.send(m.from, m.tag, "");
+      --remote_lanes;
+    } else {
+      cluster.send(m.from, m.tag, json{{"index", *i}, {"args", render_arguments(batch.job(*i))}}.dump());
+    }
+  }
+}
+
+// A lane of another rank than 0: asks rank 0 for jobs (its tag: the lane's number),
+// runs each as a process of its own on the lane's devices, and says how it went.
+void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool quiet, const JobRunner& run) {
+  json said = {{"host", cluster.host()}, {"devices", devices}};
+  for (;;) {
+    cluster.send(0, tag, said.dump());
+    const std::string answer = cluster.receive(0, tag);
+    if (answer.empty()) return;
+    const json given = json::parse(answer);
+    const size_t index = given["index"].get<size_t>();
+    JobOutcome o;
+    try {
+      o = run(index, lane_job(parse_render_arguments(given["args"].get<std::vector<std::string>>()), devices, quiet));
+    } catch (const std::exception& e) {
+      o.exit_code = kExitFailure;
+      o.message = std::string("rank ") + std::to_string(cluster.rank()) + " could not take the job: " + e.what();
+    }
+    said = outcome_json(index, o);
+    said["host"] = cluster.host();
+    said["devices"] = devices;
+  }
+}
+
+}  // namespace
+
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
-                           const std::vector<std::string>& lanes) {
+                           const std::vector<std::string>& lanes, const Cluster& cluster) {
   const SignalForwarder signals;
   const JobRunner run = [&](size_t index, const Job& job) {
     return run_job_in_process(executable, index, job, signals);
   };
-  return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes);
+  if (!cluster.distributed()) return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes);
+
+  // An MPI run: every rank's lanes take jobs as they free up; rank 0 hands them out
+  // and alone prints the summary.
+  const std::vector<std::string> counts = cluster.gather(std::to_string(lanes.size()));
+  const bool quiet = cluster.ranks() > 1 || lanes.size() > 1;
+  std::vector<std::thread> threads;
+  if (!cluster.root()) {
+    for (size_t l = 0; l < lanes.size(); ++l) {
+      threads.emplace_back([&, l] { rank_lane(cluster, static_cast<int>(l), lanes[l], quiet, run); });
+    }
+    for (std::thread& t : threads) t.join();
+    return signals.caught() ? 128 + signals.caught() : 0;
+  }
+  size_t remote_lanes = 0;
+  for (size_t r = 1; r < counts.size(); ++r) remote_lanes += std::stoul(counts[r]);
+  BatchRun batch(jobs, skip_done, [&] { return signals.caught(); });
+  for (const std::string& devices : lanes) threads.emplace_back([&, devices] { batch.lane(run, devices, quiet); });
+  serve_ranks(cluster, batch, remote_lanes);
+  for (std::thread& t : threads) t.join();
+  return batch.summary();
+}
+
+void release_ranks(const Cluster& cluster) {
+  const std::vector<std::string> counts = cluster.gather("0");
+  size_t remote_lanes = 0;
+  for (size_t r = 1; r < counts.size(); ++r) remote_lanes += std::stoul(counts[r]);
+  const std::vector<PlannedJob> none;
+  BatchRun batch(none, false, nullptr);
+  serve_ranks(cluster, batch, remote_lanes);
 }
 
 }  // namespace wt::app

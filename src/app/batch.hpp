@@ -37,11 +37,19 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
 // device of `devices` ("all" or a list; `present` devices), or with fewer jobs than
 // devices one per job, each over its share of them; a single lane ("": the jobs'
 // own devices) on the CPU backend or with one device. Throws SceneError for a bad list.
+// Of an MPI run, the ranks on one host share its devices out (distributed.hpp's local_share).
 std::vector<std::string> batch_lanes(const std::string& devices, const std::string& backend, size_t jobs,
-                                     int present);
+                                     int present, const Cluster& cluster = Cluster());
 
 // Runs each job as `wavetrace render` in a process of its own, the lanes' jobs at once.
+// As a rank of an MPI run (every rank calls it), rank 0 hands the jobs of `jobs` out
+// to every rank's lanes as they free up and alone prints the summary; the other
+// ranks' `jobs` are not read.
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
-                           const std::vector<std::string>& lanes = {""});
+                           const std::vector<std::string>& lanes = {""}, const Cluster& cluster = Cluster());
+
+// Rank 0 of an MPI batch that has no jobs to give (its jobs file was refused): tells
+// the other ranks' lanes so, which then end (the others call run_batch_in_processes).
+void release_ranks(const Cluster& cluster);
 
 }  // namespace wt::app

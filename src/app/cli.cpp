@@ -77,4 +77,14 @@ std::vector<std::string> render_arguments(const Job& job) {
   return args;
 }
 
+Job parse_render_arguments(const std::vector<std::string>& args) {
+  CLI::App app;
+  RenderCommand cmd;
+  add_render_command(app, cmd);
+  std::vector<const char*> argv = {"wavetrace"};
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  app.parse(static_cast<int>(argv.size()), argv.data());
+  return cmd.parsed();
+}
+
 }  // namespace wt::app

@@ -31,5 +31,8 @@ CLI::App* add_render_command(CLI::App& app, RenderCommand& cmd);
 // option for every field of the job that differs from a default Job, the scene last.
 // Parsing it with add_render_command gives `job` back.
 std::vector<std::string> render_arguments(const Job& job);
+// The job such a command line renders (parsed as main parses it); throws
+// CLI::ParseError for one that is not.
+Job parse_render_arguments(const std::vector<std::string>& args);
 
 }  // namespace wt::app

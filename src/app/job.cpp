@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/checkpoint.hpp"
+#include "app/distributed.hpp"
 #include "app/progress.hpp"
 #include "app/signals.hpp"
 #include "app/stats.hpp"
@@ -161,37 +162,89 @@ void recover_device(JobOutcome& out) {
 
 }  // namespace
 
-JobOutcome run_job(const Job& job) {
-  JobOutcome out;
+namespace {
+
+// Runs one phase of a job: its errors become the outcome's exit code and message.
+template <class F>
+void guarded(JobOutcome& out, F&& phase) {
   try {
-    check_output_path(job.output);
-    if (!job.stats.empty()) check_output_path_for_text(job.stats);
-    // The CUDA context starts while the scene loads: that of the first device the job
-    // renders on (a batch lane's job starts none on another lane's device). A bad
-    // device list is left for the render's own parse below to report.
-    std::thread context;
-    if (job.backend != "cpu") {
-      context = std::thread([&job] {
-        int first = 0;
-        try {
-          const std::vector<int> devices = parse_devices(job.devices, Backend::Cuda, cuda::device_count());
-          if (!devices.empty()) first = devices[0];
-        } catch (const SceneError&) {
-        }
-        cuda::start_context(first);
-      });
-    }
-    struct Joined {
-      std::thread& t;
-      ~Joined() {
-        if (t.joinable()) t.join();
+    phase();
+  } catch (const SceneError& e) {
+    out.exit_code = kExitBadInput;
+    out.message = e.what();
+  } catch (const OutputWriteError& e) {
+    out.exit_code = kExitFailure;  // the path was fine; the disk was not
+    out.message = e.what();
+  } catch (const OutputError& e) {
+    out.exit_code = kExitBadInput;
+    out.message = e.what();
+  } catch (const DeviceError& e) {
+    out.exit_code = kExitFailure;
+    out.message = (dynamic_cast<const cuda::CudaError*>(&e) ? "CUDA error: " : "") + std::string(e.what());
+    recover_device(out);
+  } catch (const std::bad_alloc&) {
+    out.exit_code = kExitFailure;
+    out.message = "out of host memory (std::bad_alloc)";
+  } catch (const std::exception& e) {
+    out.exit_code = kExitFailure;
+    out.message = e.what();
+  } catch (...) {
+    out.exit_code = kExitFailure;
+    out.message = "failed with an unknown error";
+  }
+}
+
+// What every rank of an MPI render must share: the settings, kernel and scene's size.
+std::string render_signature(const JobOutcome& o) {
+  const RenderParams& p = o.params;
+  return std::to_string(p.width) + "x" + std::to_string(p.height) + ", " + std::to_string(p.spp) + " spp, depth " +
+         std::to_string(p.depth) + ", roulette depth " + std::to_string(p.roulette_depth) + ", seed " +
+         std::to_string(p.seed) + ", light sampling " + std::to_string(p.nee) + ", " + o.backend + "/" + o.kernel +
+         ", " + std::to_string(o.geometry.spheres) + " spheres and " + std::to_string(o.geometry.instanced_triangles) +
+         " triangles";
+}
+
+}  // namespace
+
+JobOutcome run_job(const Job& job) { return run_job(job, Cluster()); }
+
+JobOutcome run_job(const Job& job, const Cluster& cluster) {
+  JobOutcome out;
+  const bool distributed = cluster.distributed();
+  // The CUDA context starts while the scene loads: that of the first device the job
+  // renders on (a batch lane's job starts none on another lane's device). A bad
+  // device list is left for the render's own parse below to report.
+  std::thread context;
+  if (job.backend != "cpu") {
+    context = std::thread([&job] {
+      int first = 0;
+      try {
+        const std::vector<int> devices = parse_devices(job.devices, Backend::Cuda, cuda::device_count());
+        if (!devices.empty()) first = devices[0];
+      } catch (const SceneError&) {
       }
-    } joined{context};
-    Scene scene = load_scene(job.scene);
-    out.load_times = scene.load_times;
-    out.geometry = scene.summary();
-    RenderOptions options;
-    options.params = resolve_params(scene, job);
+      cuda::start_context(first);
+    });
+  }
+  struct Joined {
+    std::thread& t;
+    ~Joined() {
+      if (t.joinable()) t.join();
+    }
+  } joined{context};
+
+  std::optional<Scene> scene;
+  RenderOptions options;
+  guarded(out, [&] {
+    // Of an MPI run, rank 0 alone writes.
+    if (cluster.root()) {
+      check_output_path(job.output);
+      if (!job.stats.empty()) check_output_path_for_text(job.stats);
+    }
+    scene.emplace(load_scene(job.scene));
+    out.load_times = scene->load_times;
+    out.geometry = scene->summary();
+    options.params = resolve_params(*scene, job);
     options.kernel = parse_kernel(job.kernel);
     options.backend = parse_backend(job.backend);
     options.warmup = static_cast<int>(job.warmup);
@@ -201,8 +254,46 @@ JobOutcome run_job(const Job& job) {
     out.params = options.params;
     out.backend = backend_name(options.backend);
     out.kernel = kernel_name(options.kernel);
+    if (distributed) {
+      if (!job.checkpoint.empty() || !job.resume.empty()) {
+        throw SceneError(std::string(job.checkpoint.empty() ? "resume" : "checkpoint") +
+                         ": checkpoints are kept by one process; a render over " + std::to_string(cluster.ranks()) +
+                         " MPI ranks has none (render its parts as jobs of a batch instead)");
+      }
+      if (options.backend == Backend::Cuda) {
+        // The ranks of one host share its GPUs out.
+        std::vector<int> devices = options.devices;
+        if (devices.empty()) {
+          for (int d = 0; d < cuda::device_count(); ++d) devices.push_back(d);
+        }
+        options.devices = local_share(devices, cluster.local_rank(), cluster.local_ranks());
+      } else if (options.threads == 0) {
+        // The ranks of one host share its cores out.
+        options.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / cluster.local_ranks());
+      }
+    }
+  });
+  if (distributed) {
+    const double weight = options.backend == Backend::Cuda ? std::max<size_t>(1, options.devices.size())
+                                                           : std::max(1, options.threads);
+    if (!agree_on_samples(cluster, out, options, render_signature(out), weight)) return out;
+  }
+  if (out.exit_code != 0) return out;
 
+  guarded(out, [&] {
     const RenderParams& rp = options.params;
+    if (distributed) {
+      // This rank's samples; rank 0 adds the others' sums to its own.
+      if (options.sample_count > 0) {
+        ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * options.sample_count);
+        if (job.progress && cluster.root()) options.progress = progress.callback();  // rank 0's part
+        out.result = render_sums(*scene, options);
+      } else {
+        out.result.rgb.assign(static_cast<size_t>(rp.width) * rp.height * 3, 0.0f);
+        out.result.device = "no samples";
+      }
+      return;
+    }
     // Checkpoints go to job.checkpoint, or back into the file resumed from.
     const std::string checkpoint_path = job.checkpoint.empty() ? job.resume : job.checkpoint;
     Checkpoint resumed;
@@ -241,16 +332,23 @@ JobOutcome run_job(const Job& job) {
     } else {
       ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
       if (job.progress) options.progress = progress.callback();
-      out.result = render(scene, options);
+      out.result = render(*scene, options);
     }
     if (out.result.interrupted) {
       const int sig = signals->caught();
       out.exit_code = 128 + sig;
-      out.message = "interrupted by " + signal_name(sig) + " at sample " +
-                    std::to_string(out.result.samples) + " of " + std::to_string(rp.spp) +
-                    "; checkpoint written to " + checkpoint_path + " (resume with --resume " + checkpoint_path + ")";
-      return out;
+      out.message = "interrupted by " + signal_name(sig) + " at sample " + std::to_string(out.result.samples) +
+                    " of " + std::to_string(rp.spp) + "; checkpoint written to " + checkpoint_path +
+                    " (resume with --resume " + checkpoint_path + ")";
     }
+    // The image is about to be written: the checkpoint has served its purpose once it is.
+    out.checkpoint = checkpoint_path;
+  });
+  if (distributed) combine_results(cluster, out);
+  if (out.exit_code != 0 || !cluster.root()) return out;
+
+  guarded(out, [&] {
+    if (distributed) take_mean(out.result);
     // Both files are written in full before either takes its name: a disk that fills
     // up during the second leaves neither.
     StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
@@ -259,35 +357,13 @@ JobOutcome run_job(const Job& job) {
     image.commit();
     stats.commit();
     // The image is written: the checkpoint has served its purpose.
-    if (!checkpoint_path.empty()) std::filesystem::remove(checkpoint_path);
+    if (!out.checkpoint.empty()) std::filesystem::remove(out.checkpoint);
     if (job.profile) {
       print_load_times(out.load_times, out.result.upload_seconds);
       print_geometry(out.geometry);
       print_profile(out.result);
     }
-  } catch (const SceneError& e) {
-    out.exit_code = kExitBadInput;
-    out.message = e.what();
-  } catch (const OutputWriteError& e) {
-    out.exit_code = kExitFailure;  // the path was fine; the disk was not
-    out.message = e.what();
-  } catch (const OutputError& e) {
-    out.exit_code = kExitBadInput;
-    out.message = e.what();
-  } catch (const DeviceError& e) {
-    out.exit_code = kExitFailure;
-    out.message = (dynamic_cast<const cuda::CudaError*>(&e) ? "CUDA error: " : "") + std::string(e.what());
-    recover_device(out);
-  } catch (const std::bad_alloc&) {
-    out.exit_code = kExitFailure;
-    out.message = "out of host memory (std::bad_alloc)";
-  } catch (const std::exception& e) {
-    out.exit_code = kExitFailure;
-    out.message = e.what();
-  } catch (...) {
-    out.exit_code = kExitFailure;
-    out.message = "failed with an unknown error";
-  }
+  });
   return out;
 }
 

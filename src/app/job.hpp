@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "app/cluster.hpp"
 #include "image/image_io.hpp"
 #include "render/renderer.hpp"
 #include "render/settings.hpp"
@@ -54,6 +55,7 @@ struct JobOutcome {
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
   std::string backend, kernel;
   RenderResult result;
+  std::string checkpoint;  // the render's checkpoint file, removed once its image is written
 };
 
 // Runs a job; never throws. Writes the image (and stats) only when the render and
@@ -61,6 +63,9 @@ struct JobOutcome {
 // device fit for the next job (cuda::recover_after_error); after a sticky one it says
 // that the context cannot be recovered and sets device_lost.
 JobOutcome run_job(const Job& job);
+// The same job as one rank of an MPI run (app/distributed.hpp): every rank calls it;
+// rank 0 alone writes, and every rank's outcome fails where any rank's part did.
+JobOutcome run_job(const Job& job, const Cluster& cluster);
 
 // Sets a setting of the table (already checked against its range).
 void set_setting(Job& job, SettingId id, int64_t value);

@@ -1,10 +1,13 @@
 // The wavetrace command: render one scene, or a batch of jobs.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include "app/batch.hpp"
 #include "app/bench.hpp"
+#include "app/cluster.hpp"
 #include "app/cli.hpp"
 #include "app/job.hpp"
 #include "cuda/device.hpp"
@@ -13,7 +16,30 @@
 
 using wt::app::Job;
 
+namespace {
+
+int run(int argc, char** argv, const wt::app::Cluster& cluster);
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  // Under an MPI launcher, this process is one rank of several (app/cluster.hpp).
+  wt::app::Cluster cluster;
+  try {
+    cluster = wt::app::start_cluster(&argc, &argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    wt::app::end_cluster();
+    return wt::app::kExitFailure;
+  }
+  const int code = run(argc, argv, cluster);
+  wt::app::end_cluster();
+  return code;
+}
+
+namespace {
+
+int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   CLI::App app{"wavetrace: a wavefront path tracer, with the megakernel kept for comparison"};
   app.require_subcommand(1);
 
@@ -51,17 +77,27 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    if (cluster.distributed()) {
+      // The other ranks may have parsed theirs, and wait for this one: the run ends here.
+      std::fprintf(stderr, "wavetrace: %s: %s; the MPI run is stopped\n", cluster.name(cluster.rank()).c_str(),
+                   e.what());
+      std::fflush(stderr);
+      wt::app::abort_cluster(wt::app::kExitBadInput);
+    }
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     return wt::app::kExitBadInput;
   }
 
   if (*render) {
-    const Job job = render_command.parsed();
-    wt::app::JobOutcome o = wt::app::run_job(job);
+    Job job = render_command.parsed();
+    if (!cluster.root()) job.progress = false;
+    wt::app::JobOutcome o = wt::app::run_job(job, cluster);
     if (o.exit_code != 0) {
-      std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
+      // Of an MPI run, rank 0 says what failed where; every rank exits with its code.
+      if (cluster.root()) std::fprintf(stderr, "wavetrace: %s\n", o.message.c_str());
       return o.exit_code;
     }
+    if (!cluster.root()) return 0;
     const wt::RenderResult& r = o.result;
     std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
                  o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
@@ -82,6 +118,10 @@ int main(int argc, char** argv) {
   }
 
   if (*bench) {
+    if (cluster.distributed()) {
+      if (cluster.root()) std::fprintf(stderr, "wavetrace: bench times one process; run it without mpirun\n");
+      return wt::app::kExitBadInput;
+    }
     try {
       return wt::app::run_bench(bench_options);
     } catch (const std::exception& e) {
@@ -91,7 +131,19 @@ int main(int argc, char** argv) {
   }
 
   wt::app::set_encoding(batch_job, batch_encoding);
+  // Its jobs render alone, whatever MPI run the batch is a rank of.
+  if (cluster.distributed()) setenv(wt::app::kSingleProcessVariable, "1", 1);
   std::vector<wt::app::PlannedJob> jobs;
+  if (!cluster.root()) {
+    // Rank 0 reads the jobs and hands them out; this rank's lanes run what it gives.
+    std::vector<std::string> lanes;
+    try {
+      lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, SIZE_MAX, wt::cuda::device_count(), cluster);
+    } catch (const wt::SceneError&) {
+      lanes = {""};  // rank 0 reads the same list, and says what is wrong with it
+    }
+    return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster);
+  }
   try {
     // One input that is a jobs file; otherwise every input is a scene file.
     if (inputs.size() == 1 && wt::app::is_jobs_file(inputs[0])) {
@@ -106,6 +158,7 @@ int main(int argc, char** argv) {
     }
   } catch (const wt::SceneError& e) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
   }
   // Each job runs as `wavetrace render` in a process of its own: a clean CUDA context
@@ -113,10 +166,13 @@ int main(int argc, char** argv) {
   // devices the jobs run at once, a device (or a share of them) each.
   std::vector<std::string> lanes;
   try {
-    lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, jobs.size(), wt::cuda::device_count());
+    lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, jobs.size(), wt::cuda::device_count(), cluster);
   } catch (const wt::SceneError& e) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
+    if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
   }
-  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes);
+  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster);
 }
+
+}  // namespace

@@ -18,6 +18,12 @@ void validate_params(const RenderParams& p) {
 RenderParams default_params(const Scene& scene) { return scene.render; }
 
 RenderResult render(const Scene& scene, const RenderOptions& options) {
+  RenderResult r = render_sums(scene, options);
+  take_mean(r);
+  return r;
+}
+
+RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
   const RenderParams& p = options.params;
   validate_params(p);
   if (options.wave_size != 0) check_setting(SettingId::WaveSize, options.wave_size);
@@ -33,9 +39,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
                      " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
                      std::to_string(film_floats));
   }
-  RenderResult r = options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
-  take_mean(r);
-  return r;
+  return options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
 }
 
 void take_mean(RenderResult& r) {

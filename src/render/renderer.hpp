@@ -14,6 +14,10 @@ const char* backend_name(Backend b);
 // and DeviceError (cuda::CudaError for CUDA calls, naming the call and the stage)
 // when the machine fails. The result holds each pixel's mean radiance.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+// The same render, its result the pixels' sums over the samples it rendered
+// (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
+// sums are added to others' (the ranks of an MPI run).
+RenderResult render_sums(const Scene& scene, const RenderOptions& options);
 
 // Turns a backend's pixel sums over r.samples samples into means (every render's
 // last step; also for a film that was complete when it was resumed).

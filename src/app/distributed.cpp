@@ -1,0 +1,212 @@
+#include "app/distributed.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <nlohmann/json.hpp>
+
+namespace wt::app {
+
+using nlohmann::json;
+
+std::vector<SamplePass> rank_samples(int32_t first, int32_t count, const std::vector<double>& weights) {
+  std::vector<SamplePass> out;
+  double total = 0;
+  for (double w : weights) total += w;
+  // Cumulative rounding: each boundary is the rounded share of the weights before it,
+  // so the ranges tile [first, first + count) exactly.
+  double before = 0;
+  int32_t at = first;
+  for (size_t r = 0; r < weights.size(); ++r) {
+    before += weights[r];
+    const int32_t end =
+        r + 1 == weights.size() ? first + count : first + static_cast<int32_t>(std::llround(count * (before / total)));
+    out.push_back(SamplePass{at, end - at});
+    at = end;
+  }
+  return out;
+}
+
+std::vector<int> local_share(const std::vector<int>& devices, int local_rank, int local_ranks) {
+  if (devices.empty() || local_ranks <= 1) return devices;
+  if (static_cast<int>(devices.size()) <= local_ranks) {
+    return {devices[static_cast<size_t>(local_rank) % devices.size()]};
+  }
+  std::vector<int> mine;
+  for (size_t i = static_cast<size_t>(local_rank); i < devices.size(); i += static_cast<size_t>(local_ranks)) {
+    mine.push_back(devices[i]);
+  }
+  return mine;
+}
+
+std::string describe_failures(const std::vector<RankStatus>& failed, int ranks) {
+  // Clauses in the order of their first rank; ranks with the same message share one.
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<const RankStatus*>> by_message;
+  for (const RankStatus& s : failed) {
+    if (!by_message.count(s.message)) order.push_back(s.message);
+    by_message[s.message].push_back(&s);
+  }
+  std::string line;
+  for (const std::string& message : order) {
+    const std::vector<const RankStatus*>& list = by_message[message];
+    std::string who = list.size() == 1 ? "rank " : "ranks ";
+    std::string hosts;
+    for (size_t i = 0; i < list.size(); ++i) {
+      who += (i ? ", " : "") + std::to_string(list[i]->rank);
+      if (hosts.find(list[i]->host) == std::string::npos) hosts += (hosts.empty() ? "" : ", ") + list[i]->host;
+    }
+    line += (line.empty() ? "" : "; ") + who + " of " + std::to_string(ranks) +
+            (hosts.empty() ? "" : " (" + hosts + ")") + ": " + message;
+  }
+  return line;
+}
+
+namespace {
+
+json status_of(const Cluster& cluster, const JobOutcome& out) {
+  return json{{"host", cluster.host()}, {"exit_code", out.exit_code}, {"message", out.message}};
+}
+
+RankStatus rank_status(int rank, const json& j) {
+  return RankStatus{rank, j.value("host", ""), j.value("exit_code", 1), j.value("message", "")};
+}
+
+// Rank 0's verdict on the gathered statuses: the failed ranks' line, or "" if none.
+std::pair<int, std::string> verdict(const Cluster& cluster, const std::vector<json>& statuses) {
+  std::vector<RankStatus> failed;
+  for (size_t r = 0; r < statuses.size(); ++r) {
+    RankStatus s = rank_status(static_cast<int>(r), statuses[r]);
+    if (s.exit_code != 0) failed.push_back(s);
+  }
+  if (failed.empty()) return {0, ""};
+  return {failed.front().exit_code, describe_failures(failed, cluster.ranks())};
+}
+
+// Every rank takes rank 0's decision: none (and `out` failed) where it says so.
+std::optional<json> take_decision(const Cluster& cluster, JobOutcome& out, const json& decision) {
+  json d = json::parse(cluster.broadcast(cluster.root() ? decision.dump() : std::string()));
+  if (d.value("exit_code", 0) == 0) return d;
+  out.exit_code = d.value("exit_code", 1);
+  out.message = d.value("message", "");
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool agree_on_samples(const Cluster& cluster, JobOutcome& out, RenderOptions& options, const std::string& signature,
+                      double weight) {
+  json mine = status_of(cluster, out);
+  mine["signature"] = signature;
+  mine["weight"] = weight;
+  json decision;
+  if (cluster.root()) {
+    std::vector<json> statuses;
+    for (const std::string& s : cluster.gather(mine.dump())) statuses.push_back(json::parse(s));
+    auto [code, line] = verdict(cluster, statuses);
+    if (code == 0) {
+      // Every rank renders the same: its settings, kernel and scene as rank 0's.
+      std::vector<RankStatus> differing;
+      const std::string& ours = statuses[0]["signature"].get_ref<const std::string&>();
+      for (size_t r = 1; r < statuses.size(); ++r) {
+        const std::string theirs = statuses[r].value("signature", "");
+        if (theirs != ours) {
+          differing.push_back(RankStatus{static_cast<int>(r), statuses[r].value("host", ""), kExitBadInput,
+                                         "renders " + theirs + ", rank 0 " + ours});
+        }
+      }
+      if (!differing.empty()) {
+        code = kExitBadInput;
+        line = describe_failures(differing, cluster.ranks());
+      }
+    }
+    decision = {{"exit_code", code}, {"message", line}};
+    if (code == 0) {
+      std::vector<double> weights;
+      for (const json& s : statuses) weights.push_back(std::max(1.0, s.value("weight", 1.0)));
+      const RenderParams& rp = options.params;
+      json ranges = json::array();
+      for (const SamplePass& p : rank_samples(options.first_sample, rp.spp - options.first_sample, weights)) {
+        ranges.push_back({p.first, p.count});
+      }
+      decision["ranges"] = ranges;
+    }
+  } else {
+    cluster.gather(mine.dump());
+  }
+  const std::optional<json> d = take_decision(cluster, out, decision);
+  if (!d) return false;
+  const json& range = (*d)["ranges"][static_cast<size_t>(cluster.rank())];
+  options.first_sample = range[0].get<int32_t>();
+  options.sample_count = range[1].get<int32_t>();
+  return true;
+}
+
+void combine_results(const Cluster& cluster, JobOutcome& out) {
+  const RenderResult& r = out.result;
+  json mine = status_of(cluster, out);
+  if (out.exit_code == 0) {
+    json shares = json::array();
+    for (const DeviceShare& s : r.shares) {
+      shares.push_back({{"device", s.device}, {"name", s.name}, {"samples", s.samples}, {"chunks", s.chunks},
+                        {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}});
+    }
+    mine["result"] = {{"rays", r.rays},       {"shadow_rays", r.shadow_rays}, {"paths", r.paths},
+                      {"seconds", r.seconds}, {"upload_seconds", r.upload_seconds},
+                      {"device", r.device},   {"shares", shares}};
+  }
+  json decision;
+  std::vector<json> statuses;
+  if (cluster.root()) {
+    for (const std::string& s : cluster.gather(mine.dump())) statuses.push_back(json::parse(s));
+    auto [code, line] = verdict(cluster, statuses);
+    decision = {{"exit_code", code}, {"message", line}};
+  } else {
+    cluster.gather(mine.dump());
+  }
+  if (!take_decision(cluster, out, decision)) return;
+  cluster.sum_to_root(out.result.rgb);
+  if (!cluster.root()) return;
+  // The whole render, as rank 0 reports it: every rank's counts, and its devices.
+  RenderResult whole;
+  whole.rgb = std::move(out.result.rgb);
+  whole.radiance = Radiance::SumOfSamples;
+  whole.samples = out.params.spp;
+  whole.device = std::to_string(cluster.ranks()) + " ranks";
+  const uint64_t pixels = static_cast<uint64_t>(out.params.width) * out.params.height;
+  for (size_t rank = 0; rank < statuses.size(); ++rank) {
+    const json& s = statuses[rank]["result"];
+    const std::string who = "rank " + std::to_string(rank) + " (" + statuses[rank].value("host", "") + ")";
+    whole.rays += s.value("rays", uint64_t(0));
+    whole.shadow_rays += s.value("shadow_rays", uint64_t(0));
+    whole.paths += s.value("paths", uint64_t(0));
+    whole.seconds = std::max(whole.seconds, s.value("seconds", 0.0));
+    whole.upload_seconds = std::max(whole.upload_seconds, s.value("upload_seconds", 0.0));
+    if (s["shares"].empty()) {
+      DeviceShare d;
+      d.device = who;
+      d.name = s.value("device", "");
+      d.samples = static_cast<int32_t>(s.value("paths", uint64_t(0)) / pixels);
+      d.chunks = d.samples > 0 ? 1 : 0;
+      d.seconds = s.value("seconds", 0.0);
+      d.rays = s.value("rays", uint64_t(0));
+      d.shadow_rays = s.value("shadow_rays", uint64_t(0));
+      whole.shares.push_back(d);
+    }
+    for (const json& j : s["shares"]) {
+      DeviceShare d;
+      d.device = who + " " + j.value("device", "");
+      d.name = j.value("name", "");
+      d.samples = j.value("samples", 0);
+      d.chunks = j.value("chunks", 0);
+      d.seconds = j.value("seconds", 0.0);
+      d.rays = j.value("rays", uint64_t(0));
+      d.shadow_rays = j.value("shadow_rays", uint64_t(0));
+      whole.shares.push_back(d);
+    }
+  }
+  out.result = std::move(whole);
+}
+
+}  // namespace wt::app
