@@ -85,34 +85,14 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   for (size_t d = 0; d < devices; ++d) out.shares[d].device = labels[d];
 
   std::mutex m;
-  std::condition_variable ready_cv;
-  size_t ready = 0, next = 0, folded = 0;
+  std::condition_variable ready_cv, chunk_cv;
+  size_t ready = 0, next = 0, folded = 0, working = devices;
   std::vector<std::vector<float>> waiting(chunks.size());  // chunk sums not yet folded
   std::vector<char> finished(chunks.size(), 0);
   bool stop = false;
   std::exception_ptr error;
   std::string failed_device;
   std::chrono::steady_clock::time_point start;
-
-  // Folds finished chunks into the film in their order (under m); false when
-  // after_pass asked to stop.
-  auto fold = [&]() {
-    while (folded < chunks.size() && finished[folded]) {
-      const std::vector<float>& sums = waiting[folded];
-      for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
-      std::vector<float>().swap(waiting[folded]);
-      out.samples = chunks[folded].first + chunks[folded].count;
-      ++folded;
-      if (options.after_pass && !options.after_pass(out.samples, [&] { return out.rgb; })) return false;
-      if (options.progress) {
-        uint64_t rays = 0;
-        for (const DeviceShare& s : out.shares) rays += s.rays;
-        options.progress(static_cast<double>(folded) / chunks.size(), rays,
-                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      }
-    }
-    return true;
-  };
 
   auto work = [&](size_t d) {
     try {
@@ -161,7 +141,7 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
         waiting[c] = std::move(r.rgb);
         finished[c] = 1;
-        if (!stop && !fold()) stop = true;
+        chunk_cv.notify_all();
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(m);
@@ -172,10 +152,42 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
       stop = true;
       ready_cv.notify_all();
     }
+    std::lock_guard<std::mutex> lock(m);
+    --working;
+    chunk_cv.notify_all();
   };
 
   std::vector<std::thread> threads;
   for (size_t d = 0; d < devices; ++d) threads.emplace_back(work, d);
+  // This thread folds the finished chunks into the film in their order while the
+  // devices render the next ones; after_pass may stop the render after any chunk.
+  {
+    std::unique_lock<std::mutex> lock(m);
+    for (;;) {
+      chunk_cv.wait(lock, [&] { return stop || working == 0 || (folded < chunks.size() && finished[folded]); });
+      if (stop || folded == chunks.size() || !finished[folded]) break;
+      std::vector<float> sums = std::move(waiting[folded]);
+      lock.unlock();
+      for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
+      sums = {};
+      lock.lock();
+      out.samples = chunks[folded].first + chunks[folded].count;
+      ++folded;
+      if (options.after_pass || options.progress) {
+        uint64_t rays = 0;
+        for (const DeviceShare& s : out.shares) rays += s.rays;
+        const int32_t samples = out.samples;
+        lock.unlock();
+        const bool go_on = !options.after_pass || options.after_pass(samples, [&] { return out.rgb; });
+        if (go_on && options.progress) {
+          options.progress(static_cast<double>(folded) / chunks.size(), rays,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        }
+        lock.lock();
+        if (!go_on) stop = true;
+      }
+    }
+  }
   for (std::thread& t : threads) t.join();
   if (error) split_detail::rethrow_naming(error, failed_device);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
