@@ -5,6 +5,7 @@
 #pragma once
 
 #include "queues/soa.hpp"
+#include "wavetrace/geometry/geometry.hpp"
 #include "wavetrace/ray.hpp"
 
 namespace wt {
@@ -48,6 +49,29 @@ struct ShadowState {
 WT_SOA_QUEUE(PathQueue, PathState, WT_PATH_FIELDS);
 WT_SOA_QUEUE(ShadowQueue, ShadowState, WT_SHADOW_FIELDS);
 WT_SOA_QUEUE(HitQueue, Hit, WT_HIT_FIELDS);
+
+// A hit as intersect keeps it for shade. Of a scene of spheres alone, only its
+// distance and sphere: a sphere's surface, material and emitter need no more, and
+// the other three fields are 12 of the 20 bytes a ray would write (and a warp's
+// whole 32-byte sectors). Kinds: the scene's, as both stages are compiled for.
+template <uint32_t Kinds>
+WT_HD WT_INLINE void store_hit(const HitQueue& q, uint32_t i, const Hit& h) {
+  if constexpr (spheres_only(Kinds)) {
+    q.t[i] = h.t;
+    q.prim[i] = h.prim;
+  } else {
+    q.store(i, h);
+  }
+}
+
+template <uint32_t Kinds>
+WT_HD WT_INLINE Hit load_hit(const HitQueue& q, uint32_t i) {
+  if constexpr (spheres_only(Kinds)) {
+    return Hit{q.t[i], 0, q.prim[i], 0.0f, 0.0f};
+  } else {
+    return q.load(i);
+  }
+}
 
 // Sort entries pack the material sort key above the slot index, so one 32-bit
 // radix sort over the key bits alone carries the slot with it.

@@ -19,7 +19,7 @@ template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& scene, const RenderParams& rp,
                                        const PathQueue& q, const HitQueue& hits, float* film) {
   Hit h = intersect_scene<Kinds>(scene, ray);
-  hits.store(i, h);
+  store_hit<Kinds>(hits, i, h);
   if (h.missed()) {
     const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);

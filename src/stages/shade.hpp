@@ -23,7 +23,7 @@ WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene
   const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
   pixel = s.path % pixels;
   vec3 radiance(0.0f);
-  bool alive = shade_hit<Kinds>(scene, rp, hits.load(slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
+  bool alive = shade_hit<Kinds>(scene, rp, load_hit<Kinds>(hits, slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
                                 s.throughput, radiance, s.pdf, shadow);
   if (radiance.x != 0.0f || radiance.y != 0.0f || radiance.z != 0.0f) accumulate_one(film, pixel, radiance);
   s.bounce += 1;
