@@ -277,7 +277,9 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     const double weight = options.backend == Backend::Cuda ? std::max<size_t>(1, options.devices.size())
                                                            : std::max(1, options.threads);
     if (!agree_on_samples(cluster, out, options, render_signature(out), weight)) return out;
+    out.ranks = cluster.ranks();
   }
+  const auto started = std::chrono::steady_clock::now();
   if (out.exit_code != 0) return out;
 
   guarded(out, [&] {
@@ -344,7 +346,10 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     // The image is about to be written: the checkpoint has served its purpose once it is.
     out.checkpoint = checkpoint_path;
   });
-  if (distributed) combine_results(cluster, out);
+  if (distributed) {
+    combine_results(cluster, out);
+    out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  }
   if (out.exit_code != 0 || !cluster.root()) return out;
 
   guarded(out, [&] {

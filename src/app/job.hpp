@@ -56,6 +56,10 @@ struct JobOutcome {
   std::string backend, kernel;
   RenderResult result;
   std::string checkpoint;  // the render's checkpoint file, removed once its image is written
+  // A render over MPI ranks: how many, and rank 0's wall-clock seconds from when every
+  // rank had its scene to the summed film (result.seconds: the slowest rank's render).
+  int ranks = 1;
+  double wall_seconds = 0;
 };
 
 // Runs a job; never throws. Writes the image (and stats) only when the render and

@@ -93,6 +93,10 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["device"] = r.device;
   j["seconds"] = r.seconds;
   if (o.resumed_from_sample > 0) j["resumed_from_sample"] = o.resumed_from_sample;
+  if (o.ranks > 1) {
+    j["ranks"] = o.ranks;
+    j["wall_seconds"] = o.wall_seconds;
+  }
   j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
   add_measurements(j, r, r.seconds, o.load_times);
   j["geometry"] = geometry_json(o.geometry);

@@ -105,6 +105,8 @@ TEST_F(MpiCommand, RanksOnTheCpuRenderTheOneProcessImage) {
     const json one = json::parse(read(path("one.json"))), three = json::parse(read(path("three.json")));
     EXPECT_EQ(three["rays"], one["rays"]);
     EXPECT_EQ(three["device"], "3 ranks");
+    EXPECT_EQ(three["ranks"], 3);
+    EXPECT_GE(three["wall_seconds"].get<double>(), three["seconds"].get<double>());  // it holds the slowest render
     ASSERT_EQ(three["devices"].size(), 3u) << three.dump(2);
     int samples = 0;
     for (size_t r = 0; r < 3; ++r) {
