@@ -62,10 +62,14 @@ Usage usage() {
 constexpr long kRssBoundKib = 4096;        // job 50 to job 500
 constexpr long kSettledRssBoundKib = 256;  // job 250 to job 500
 // Resident memory cannot see a small leak while the heap has free space to hold it;
-// the allocator's count of bytes in use can. It drifts by about 15 KiB over the 450
-// jobs without any leak (memory the threads' caches hold when they exit); a leak of
-// 300 bytes a job would be 130 KiB.
-constexpr long kHeapBoundKib = 128;  // job 50 to job 500
+// the allocator's count of bytes in use can. Counted from job 100: on the GPU the
+// first batch runs with the device full (every good job fails), so the second is the
+// first whose jobs render, and the first renders make one-time allocations there
+// (on a 2 x H200 host: 1.27 MiB by job 100, then 14 KiB over the next 400 jobs; on
+// the H100 host none after job 50; whose allocations, not found). Without a leak it
+// drifts by about 15 KiB (memory the threads' caches hold when they exit); a leak of
+// 330 bytes a job would be 130 KiB.
+constexpr long kHeapBoundKib = 128;  // job 100 to job 500
 
 constexpr int kJobsPerBatch = 50;
 constexpr int kBatches = 10;
@@ -158,7 +162,7 @@ void expect_no_growth(const Soaked& at) {
   if (test::kAddressSanitizer) return;
   EXPECT_LT(at.at_500.rss_kib - at.at_50.rss_kib, kRssBoundKib);
   EXPECT_LT(at.at_500.rss_kib - at.at_250.rss_kib, kSettledRssBoundKib);
-  EXPECT_LT(at.at_500.heap_in_use_kib - at.at_50.heap_in_use_kib, kHeapBoundKib);
+  EXPECT_LT(at.at_500.heap_in_use_kib - at.at_100.heap_in_use_kib, kHeapBoundKib);
 }
 
 TEST(Soak, FiveHundredJobsOnTheCpuGrowNeitherMemoryNorFileDescriptors) {
