@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The whole benchmark on a CUDA machine, in one command: the grid of bench/study.json
 # (each kernel's image checked against the megakernel's before it is timed), the
-# Nsight Compute profiles, and the plots and tables, all under bench/results/.
+# mesh and model scenes, the Nsight Compute profiles, the scaling study and the
+# wavefront's bytes per ray, and the plots and tables, all under bench/results/.
 #   scripts/bench.sh [BIN_DIR]     (default: build/, built first by scripts/build.sh)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -40,6 +41,9 @@ for scene in scenes/cornell-box.json scenes/glossy-lights.json scenes/sky-sun.js
   done
 done
 bash scripts/profile.sh "$bin" "$results" || status=$?
+# Throughput against resolution, samples and scene size; the wavefront's bytes per ray.
+bash scripts/scaling.sh "$bin" "$results/scaling" || status=$?
+bash scripts/bytes-per-ray.sh "$bin" "$results/bytes-per-ray" || status=$?
 python3 bench/profile_summary.py "$results" >/dev/null || status=$?
 # PYTHON: an interpreter with matplotlib (Debian's python3-matplotlib is /usr/bin/python3's).
 "${PYTHON:-python3}" bench/plot.py "$results/results.json" --out "$results" || status=$?
