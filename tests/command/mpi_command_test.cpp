@@ -53,11 +53,17 @@ class MpiCommand : public testing::Test {
   // Runs a shell command line (its {W} replaced by the program) in dir_; its exit code.
   int shell(std::string line) {
     for (size_t at; (at = line.find("{W}")) != std::string::npos;) line.replace(at, 3, "'" + g_wavetrace + "'");
-    // Containers run tests as root, which Open MPI refuses unless told.
+    // Containers run tests as root, which Open MPI refuses unless told. Under
+    // AddressSanitizer the ranks' leak check is off: Open MPI leaves its own
+    // allocations at MPI_Finalize, some made by components it has unloaded by then,
+    // which no suppression can name; the code the ranks run is the one the rest of
+    // the suite checks for leaks in a single process.
+    const bool ranks = line.rfind("mpirun", 0) == 0;
+    const std::string leaks = ranks && wt::test::kAddressSanitizer ? "ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" " : "";
     const std::string command = "cd '" + dir_.string() +
                                 "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
-                                "OMPI_MCA_rmaps_base_oversubscribe=1 timeout 120 " +
-                                line + " >out.txt 2>err.txt";
+                                "OMPI_MCA_rmaps_base_oversubscribe=1 " +
+                                leaks + "timeout 120 " + line + " >out.txt 2>err.txt";
     const int status = std::system(command.c_str());
     out_ = read(path("out.txt"));
     err_ = read(path("err.txt"));
