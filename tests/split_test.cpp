@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -163,6 +165,53 @@ TEST(Split, AFailingDeviceFailsTheRenderAndSaysWhich) {
   EXPECT_THROW(render_split(o, {"gpu:0"}, short_film), DeviceError);
 }
 
+// A device that keeps its chunks' sums (as a GPU does, in its memory) adds every
+// chunk to them and brings them back once; with after_pass, which must see the film
+// after every chunk, it is asked for every chunk's sums instead.
+TEST(Split, ADeviceThatKeepsItsSumsBringsThemBackOnce) {
+  const RenderOptions o = quick_options(Backend::Cpu, Kernel::Megakernel, {});
+  const RenderResult one = render(quick(), o);
+  std::mutex m;
+  std::atomic<int> kept_chunks{0}, plain_chunks{0}, collects{0};
+  auto keeping = [&](size_t) -> DeviceRenderer {
+    auto sums = std::make_shared<std::vector<float>>();
+    return {[&](const RenderOptions& chunk) {
+              ++plain_chunks;
+              return render_sums(quick(), chunk);
+            },
+            [&, sums](const RenderOptions& chunk) {
+              ++kept_chunks;
+              RenderResult r = render_sums(quick(), chunk);
+              std::lock_guard<std::mutex> lock(m);
+              if (sums->empty()) sums->assign(r.rgb.size(), 0.0f);
+              for (size_t i = 0; i < r.rgb.size(); ++i) (*sums)[i] += r.rgb[i];
+              r.rgb.clear();
+              return r;
+            },
+            [&, sums] {
+              ++collects;
+              return *sums;
+            }};
+  };
+  RenderResult split = render_split(o, {"gpu:0", "gpu:1", "gpu:2"}, keeping);
+  take_mean(split);
+  expect_same_image(one, split, false, "kept sums");
+  EXPECT_EQ(kept_chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * 3)));
+  EXPECT_EQ(plain_chunks, 0);
+  EXPECT_EQ(collects, 3);
+
+  RenderOptions watched = o;
+  int passes = 0;
+  watched.after_pass = [&](int32_t, const FilmReader&) { return ++passes > 0; };
+  kept_chunks = plain_chunks = collects = 0;
+  RenderResult in_order = render_split(watched, {"gpu:0", "gpu:1"}, keeping);
+  take_mean(in_order);
+  expect_same_image(one, in_order, false, "chunk order");
+  EXPECT_EQ(kept_chunks, 0);
+  EXPECT_EQ(plain_chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * 2)));
+  EXPECT_EQ(passes, plain_chunks);
+}
+
 TEST(Split, DeviceListsAreParsedAndChecked) {
   using app::parse_devices;
   EXPECT_EQ(parse_devices("all", Backend::Cuda, 2), (std::vector<int>{0, 1}));
@@ -187,8 +236,9 @@ TEST(Split, OneGpuTwiceRendersTheOneGpuImage) {
   for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
     const RenderResult one = render(quick(), quick_options(Backend::Cuda, k, {0}));
     const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 0}));
-    // Two devices: ten chunks, the megakernels' ten passes; the same additions.
-    expect_same_image(one, split, k != Kernel::Wavefront, kernel_name(k));
+    // Each worker keeps its chunks' sums on the device: the same samples, summed in
+    // other groups.
+    expect_same_image(one, split, false, kernel_name(k));
     ASSERT_EQ(split.shares.size(), 2u);
     EXPECT_EQ(split.shares[0].samples + split.shares[1].samples, 12);
   }
@@ -202,7 +252,7 @@ TEST(Split, TwoGpusRenderTheOneGpuImage) {
   for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
     const RenderResult one = render(quick(), quick_options(Backend::Cuda, k, {0}));
     const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 1}));
-    expect_same_image(one, split, k != Kernel::Wavefront, kernel_name(k));
+    expect_same_image(one, split, false, kernel_name(k));
     ASSERT_EQ(split.shares.size(), 2u);
     EXPECT_GT(split.shares[0].chunks, 0);
     EXPECT_GT(split.shares[1].chunks, 0);

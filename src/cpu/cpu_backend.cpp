@@ -97,13 +97,14 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
     const int each = std::max(1, thread_count(options.threads) / static_cast<int>(options.devices.size()));
     std::vector<std::string> labels;
     for (int d : options.devices) labels.push_back("cpu:" + std::to_string(d));
-    return render_split(options, labels, [&](size_t) -> ChunkRenderer {
-      return [&scene, each](const RenderOptions& chunk) {
-        RenderOptions one = chunk;
-        one.devices.clear();
-        one.threads = each;
-        return render(scene, one);
-      };
+    return render_split(options, labels, [&](size_t) -> DeviceRenderer {
+      return {[&scene, each](const RenderOptions& chunk) {
+                RenderOptions one = chunk;
+                one.devices.clear();
+                one.threads = each;
+                return render(scene, one);
+              },
+              {}, {}};
     });
   }
   std::vector<ImageView> images;

@@ -31,16 +31,18 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   const bool constant = options.kernel == Kernel::MegakernelConstant;
   if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
-  DeviceBuffer<float> film(pixels * 3, kStage);
+  // The render's own film, or the one it adds into (options.device_film).
+  DeviceBuffer<float> own_film(options.device_film ? 0 : pixels * 3, kStage);
+  float* const film = options.device_film ? options.device_film : own_film.get();
   DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
 
   RenderResult out;
   auto run = [&](bool last) {
     if (options.initial_film) {
-      film.upload(*options.initial_film, kStage);
+      own_film.upload(*options.initial_film, kStage);
     } else {
-      film.zero(kStage);
+      own_film.zero(kStage);  // nothing for a film of the caller's
     }
     rays.zero(kStage);
     out.samples = options.first_sample;
@@ -52,16 +54,16 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
       if (constant) {
-        launch_megakernel_constant(rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
+        launch_megakernel_constant(rp, pass.first, pass.count, film, rays.get(), nullptr);
       } else {
-        launch_megakernel(ds.view(), rp, pass.first, pass.count, film.get(), rays.get(), nullptr);
+        launch_megakernel(ds.view(), rp, pass.first, pass.count, film, rays.get(), nullptr);
       }
       pass_done[p].record("megakernel");
       out.samples = pass.first + pass.count;
       out.paths += pixels * static_cast<uint64_t>(pass.count);
       if (last && options.after_pass) {
         pass_done[p].synchronize("megakernel");
-        if (!options.after_pass(out.samples, [&] { return film.download(kStage); })) {
+        if (!options.after_pass(out.samples, [&] { return own_film.download(kStage); })) {
           out.interrupted = p + 1 < passes.size();
           break;
         }
@@ -81,7 +83,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   WT_CUDA(cudaMemcpy(counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
   out.rays = counted[0];
   out.shadow_rays = counted[1];
-  out.rgb = film.download(kStage);
+  if (!options.device_film) out.rgb = own_film.download(kStage);
   out.radiance = Radiance::SumOfSamples;
   return out;
 }
@@ -124,6 +126,26 @@ class Uploaded {
     upload_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
+  // A chunk whose sums are added to this device's kept sums (made and cleared at the
+  // first), which collect() brings back once.
+  RenderResult render_kept(const RenderOptions& options) {
+    if (!kept_) {
+      const RenderParams& rp = options.params;
+      kept_ = std::make_unique<DeviceBuffer<float>>(static_cast<size_t>(rp.width) * rp.height * 3, "split");
+      kept_->zero("split");
+      WT_CUDA(cudaDeviceSynchronize(), "split");  // cleared before any stream adds to it
+    }
+    RenderOptions into = options;
+    into.device_film = kept_->get();
+    return render(into);
+  }
+
+  std::vector<float> collect() const {
+    if (!kept_) return {};
+    WT_CUDA(cudaDeviceSynchronize(), "split");  // every chunk's additions are in
+    return kept_->download("split");
+  }
+
   RenderResult render(const RenderOptions& options) const {
     RenderResult out = is_wavefront(options.kernel)
                            ? render_wavefront(ds_->view(), scene_.sort_key_bits(), options, wave_)
@@ -138,6 +160,7 @@ class Uploaded {
   DeviceInfo info_;
   int64_t wave_ = 0;
   std::unique_ptr<DeviceScene> ds_;
+  std::unique_ptr<DeviceBuffer<float>> kept_;
   double upload_ = 0;
 };
 
@@ -150,11 +173,13 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (options.devices.size() > 1) {
     std::vector<std::string> labels;
     for (int d : options.devices) labels.push_back("cuda:" + std::to_string(d));
-    return render_split(options, labels, [&](size_t i) -> ChunkRenderer {
+    return render_split(options, labels, [&](size_t i) -> DeviceRenderer {
       // The current device is the calling thread's: the worker's from here on.
       WT_CUDA(cudaSetDevice(options.devices[i]), "device selection");
       auto uploaded = std::make_shared<Uploaded>(scene, options);
-      return [uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); };
+      return {[uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); },
+              [uploaded](const RenderOptions& chunk) { return uploaded->render_kept(chunk); },
+              [uploaded] { return uploaded->collect(); }};
     });
   }
   if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");

@@ -62,6 +62,11 @@ struct RenderOptions {
   int32_t samples_per_pass = 0;
   uint64_t max_paths_per_pass = kMaxPathsPerPass;  // lowered only by tests
   PassFn after_pass;
+  // A film on the device to add this render's sums into (render_split keeps each
+  // device's sums there across its chunks): neither cleared nor brought back, so the
+  // result's rgb is empty. Null: the render's own film. CUDA kernels only; no
+  // warm-ups, no initial film and no after_pass with it.
+  float* device_film = nullptr;
 };
 
 // What one device did in a render split over several (render/split.hpp).

@@ -42,12 +42,31 @@ inline void require_cuda_devices(const std::vector<int>& devices, int present) {
 }
 
 // What renders one device's chunks: made on that device's own thread (where it may
-// upload the scene), then called with each chunk's options, returning the chunk's
-// pixel sums (Radiance::SumOfSamples) and its counts.
+// upload the scene), then called on it with each chunk's options. `render` returns
+// the chunk's pixel sums (Radiance::SumOfSamples) and its counts. A device that can
+// keep sums of its own (a GPU, in its memory) also has `render_kept`, which adds the
+// chunk's sums to them and returns its counts alone, and `collect`, which brings
+// them back once at the end.
 using ChunkRenderer = std::function<RenderResult(const RenderOptions& chunk)>;
-using MakeChunkRenderer = std::function<ChunkRenderer(size_t device)>;
+struct DeviceRenderer {
+  DeviceRenderer(ChunkRenderer r, ChunkRenderer kept = {}, std::function<std::vector<float>()> c = {})
+      : render(std::move(r)), render_kept(std::move(kept)), collect(std::move(c)) {}
+  ChunkRenderer render;
+  ChunkRenderer render_kept;                     // may be empty
+  std::function<std::vector<float>()> collect;  // with render_kept
+};
+using MakeChunkRenderer = std::function<DeviceRenderer(size_t device)>;
 
 namespace split_detail {
+
+// Adds `more` into `sums` (taking it where `sums` is still empty).
+inline void add_into(std::vector<float>& sums, std::vector<float>&& more) {
+  if (sums.empty()) {
+    sums = std::move(more);
+    return;
+  }
+  for (size_t i = 0; i < more.size(); ++i) sums[i] += more[i];
+}
 
 // The exception `e` again, of the same kind, its message led by the device's name.
 [[noreturn]] inline void rethrow_naming(const std::exception_ptr& e, const std::string& device) {
@@ -89,6 +108,13 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   size_t ready = 0, next = 0, folded = 0, working = devices;
   std::vector<std::vector<float>> waiting(chunks.size());  // chunk sums not yet folded
   std::vector<char> finished(chunks.size(), 0);
+  // Without after_pass, which must see the film after each chunk, every device keeps
+  // the sums of its chunks (on a GPU, in its own memory: nothing comes back until the
+  // end) and the devices' sums are added in device order at the end. Which chunks a
+  // device summed depends on timing, so the image then equals the chunk-order one
+  // within float rounding rather than to the bit.
+  const bool keep = !options.after_pass;
+  std::vector<std::vector<float>> kept(devices);
   bool stop = false;
   std::exception_ptr error;
   std::string failed_device;
@@ -96,7 +122,9 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
 
   auto work = [&](size_t d) {
     try {
-      ChunkRenderer render_chunk = make(d);
+      DeviceRenderer renderer = make(d);
+      const ChunkRenderer& render_chunk = renderer.render;
+      const bool device_keeps = keep && renderer.render_kept && renderer.collect;
       RenderOptions chunk = options;
       chunk.initial_film = nullptr;
       chunk.after_pass = {};
@@ -125,11 +153,12 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         }
         chunk.first_sample = chunks[c].first;
         chunk.sample_count = chunks[c].count;
-        RenderResult r = render_chunk(chunk);
-        if (r.rgb.size() != floats) {
+        RenderResult r = device_keeps ? renderer.render_kept(chunk) : render_chunk(chunk);
+        if (!device_keeps && r.rgb.size() != floats) {
           throw DeviceError("a chunk came back with " + std::to_string(r.rgb.size()) + " film values, not " +
                             std::to_string(floats));
         }
+        if (keep && !device_keeps) split_detail::add_into(kept[d], std::move(r.rgb));
         std::lock_guard<std::mutex> lock(m);
         DeviceShare& share = out.shares[d];
         share.samples += chunks[c].count;
@@ -139,9 +168,17 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         share.shadow_rays += r.shadow_rays;
         if (share.name.empty()) share.name = r.device;
         out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
-        waiting[c] = std::move(r.rgb);
+        if (!keep) waiting[c] = std::move(r.rgb);
         finished[c] = 1;
         chunk_cv.notify_all();
+      }
+      if (device_keeps) {
+        std::vector<float> sums = renderer.collect();
+        if (sums.size() != floats && !sums.empty()) {
+          throw DeviceError("its sums came back with " + std::to_string(sums.size()) + " film values, not " +
+                            std::to_string(floats));
+        }
+        split_detail::add_into(kept[d], std::move(sums));
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(m);
@@ -168,7 +205,9 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
       if (stop || folded == chunks.size() || !finished[folded]) break;
       std::vector<float> sums = std::move(waiting[folded]);
       lock.unlock();
-      for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
+      if (!keep) {
+        for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
+      }
       sums = {};
       lock.lock();
       out.samples = chunks[folded].first + chunks[folded].count;
@@ -190,6 +229,11 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   }
   for (std::thread& t : threads) t.join();
   if (error) split_detail::rethrow_naming(error, failed_device);
+  if (keep) {
+    for (const std::vector<float>& sums : kept) {
+      for (size_t i = 0; i < sums.size(); ++i) out.rgb[i] += sums[i];
+    }
+  }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.interrupted = folded < chunks.size();
   for (const DeviceShare& s : out.shares) {

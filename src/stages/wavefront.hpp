@@ -90,14 +90,15 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const size_t temp_bytes = Exec::temp_bytes(slots);
   auto wave_memory = ex.alloc(wave_bytes(slots, temp_bytes), "wave allocation");
   const WaveView w = lay_out_wave(wave_memory.get(), slots, temp_bytes, &bytes);
-  auto film_memory = ex.alloc(film_floats * sizeof(float), "wave allocation");
-  float* film = reinterpret_cast<float*>(film_memory.get());
+  // The render's own film, or the one it adds into (options.device_film).
+  auto film_memory = ex.alloc(options.device_film ? 0 : film_floats * sizeof(float), "wave allocation");
+  float* film = options.device_film ? options.device_film : reinterpret_cast<float*>(film_memory.get());
 
   RenderResult out;
   auto run = [&](bool last) {
     if (options.initial_film) {
       ex.upload(film, *options.initial_film);
-    } else {
+    } else if (!options.device_film) {
       ex.zero(film, film_floats * sizeof(float));
     }
     std::vector<uint64_t> live_per_bounce;
@@ -168,7 +169,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   for (int i = 0; i < options.warmup; ++i) run(false);
   run(true);
 
-  out.rgb = ex.download(film, film_floats);
+  if (!options.device_film) out.rgb = ex.download(film, film_floats);
   out.radiance = Radiance::SumOfSamples;
   return out;
 }
