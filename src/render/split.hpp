@@ -59,6 +59,21 @@ using MakeChunkRenderer = std::function<DeviceRenderer(size_t device)>;
 
 namespace split_detail {
 
+// sums += more, element by element, over the host's cores.
+inline void add_in_parallel(std::vector<float>& sums, const std::vector<float>& more) {
+  if (more.empty()) return;
+  const size_t parts = std::max(1u, std::min(16u, std::thread::hardware_concurrency()));
+  const size_t each = (more.size() + parts - 1) / parts;
+  std::vector<std::thread> adders;
+  for (size_t p = 0; p < parts; ++p) {
+    adders.emplace_back([&, p] {
+      const size_t end = std::min(more.size(), (p + 1) * each);
+      for (size_t i = p * each; i < end; ++i) sums[i] += more[i];
+    });
+  }
+  for (std::thread& t : adders) t.join();
+}
+
 // Adds `more` into `sums` (taking it where `sums` is still empty).
 inline void add_into(std::vector<float>& sums, std::vector<float>&& more) {
   if (sums.empty()) {
@@ -230,9 +245,14 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   for (std::thread& t : threads) t.join();
   if (error) split_detail::rethrow_naming(error, failed_device);
   if (keep) {
-    for (const std::vector<float>& sums : kept) {
-      for (size_t i = 0; i < sums.size(); ++i) out.rgb[i] += sums[i];
+    // In device order; the first film onto zeros is itself (x + 0 is x), the others
+    // are added by as many threads as the host has, each its own range of pixels.
+    size_t d = 0;
+    if (!options.initial_film) {
+      while (d < devices && kept[d].empty()) ++d;
+      if (d < devices) out.rgb = std::move(kept[d++]);
     }
+    for (; d < devices; ++d) split_detail::add_in_parallel(out.rgb, kept[d]);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.interrupted = folded < chunks.size();
