@@ -65,9 +65,9 @@ constexpr long kSettledRssBoundKib = 256;  // job 250 to job 500
 // the allocator's count of bytes in use can. Settled (jobs 250 to 500) it drifts by
 // 6 to 18 KiB without a leak (memory the threads' caches hold when they exit); a leak
 // of 260 bytes a job would be 64 KiB. Before that the first renders may make one-time
-// allocations: none on the H100 host, about 1.1-1.3 MiB on a 2 x H200 host, once,
-// after job 50 or after job 100 (whose they are was not found; the CUDA jobs were
-// split over both GPUs then, and now run on one).
+// allocations: on a 2 x H200 host, with the CUDA jobs split over both GPUs, 1.1-1.3
+// MiB once, after job 50 or after job 100 (whose, not found); with them on one
+// device, as now, none there or on the H100 host (25 KiB from job 50 to 500).
 constexpr long kSettledHeapBoundKib = 64;  // job 250 to job 500
 constexpr long kHeapBoundKib = 2048;       // job 50 to job 500
 
