@@ -44,6 +44,14 @@ class Executor {
   int threads() const { return threads_; }
 
   HostMemory alloc(size_t bytes, const char*) { return HostMemory(bytes); }
+  unsigned char* wave_memory(size_t bytes) {
+    if (!wave_ || wave_bytes_ < bytes) {
+      wave_.reset();  // the old block first: never both at once
+      wave_ = std::make_unique<HostMemory>(bytes);
+      wave_bytes_ = bytes;
+    }
+    return wave_->get();
+  }
   static size_t temp_bytes(size_t) { return 0; }
 
   template <class Item>
@@ -102,6 +110,8 @@ class Executor {
   int threads_;
   Clock::time_point start_ = Clock::now();
   StageTimes times_;
+  std::unique_ptr<HostMemory> wave_;
+  size_t wave_bytes_ = 0;
 };
 
 }  // namespace wt::cpu

@@ -148,7 +148,7 @@ class Uploaded {
 
   RenderResult render(const RenderOptions& options) const {
     RenderResult out = is_wavefront(options.kernel)
-                           ? render_wavefront(ds_->view(), scene_.sort_key_bits(), options, wave_)
+                           ? waves_.render(ds_->view(), scene_.sort_key_bits(), options, wave_)
                            : render_megakernel(scene_, *ds_, options);
     out.upload_seconds = upload_;
     out.device = info_.name;
@@ -161,6 +161,9 @@ class Uploaded {
   int64_t wave_ = 0;
   std::unique_ptr<DeviceScene> ds_;
   std::unique_ptr<DeviceBuffer<float>> kept_;
+  // The wavefront's setup (pinned counters, the wave's memory), kept from one of this
+  // device's renders to the next.
+  mutable WaveRenderer waves_;
   double upload_ = 0;
 };
 

@@ -26,4 +26,17 @@ RenderResult render_wavefront(const SceneView& scene, int key_bits, const Render
   return wt::render_wavefront(ex, scene, key_bits, options, wave_size);
 }
 
+struct WaveRenderer::Kept {
+  Executor ex;
+};
+
+WaveRenderer::WaveRenderer() = default;
+WaveRenderer::~WaveRenderer() = default;
+
+RenderResult WaveRenderer::render(const SceneView& scene, int key_bits, const RenderOptions& options,
+                                  int64_t wave_size) {
+  if (!kept_) kept_ = std::make_unique<Kept>();  // at the first render: none for the megakernels
+  return wt::render_wavefront(kept_->ex, scene, key_bits, options, wave_size);
+}
+
 }  // namespace wt::cuda

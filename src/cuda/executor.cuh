@@ -99,6 +99,10 @@ class Executor {
   Executor& operator=(const Executor&) = delete;
 
   DeviceBuffer<unsigned char> alloc(size_t bytes, const char* stage) { return DeviceBuffer<unsigned char>(bytes, stage); }
+  unsigned char* wave_memory(size_t bytes) {
+    if (wave_.size() < bytes) wave_.allocate(bytes, "wave allocation");  // frees the old block first
+    return wave_.get();
+  }
 
   // The most temporary storage compact (over `capacity` entries) and sort need.
   static size_t temp_bytes(size_t capacity) {
@@ -230,6 +234,7 @@ class Executor {
   cudaStream_t stream_;
   EventTimer timer_;
   void* pinned_ = nullptr;
+  DeviceBuffer<unsigned char> wave_;
   std::vector<std::unique_ptr<Event>> events_;
   std::vector<Event*> free_;
   std::vector<Pending> pending_;

@@ -8,6 +8,9 @@
 //
 // An executor (cpu/executor.hpp, cuda/executor.cuh) provides:
 //   Memory alloc(bytes, stage)               an owning block with get()
+//   wave_memory(bytes) -> unsigned char*     a block the executor keeps (grown where a
+//                                            render asks for more): renders one after
+//                                            another on one executor allocate it once
 //   static size_t temp_bytes(capacity)       its compact's and sort's temporary storage
 //   launch(stage, n, item)                   item(i) for every i < n, in parallel
 //   select(stage, in, out, count, n, pred, temp, temp_bytes)  keeps in[i] with pred, in order
@@ -88,8 +91,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
 
   size_t bytes = 0;
   const size_t temp_bytes = Exec::temp_bytes(slots);
-  auto wave_memory = ex.alloc(wave_bytes(slots, temp_bytes), "wave allocation");
-  const WaveView w = lay_out_wave(wave_memory.get(), slots, temp_bytes, &bytes);
+  const WaveView w = lay_out_wave(ex.wave_memory(wave_bytes(slots, temp_bytes)), slots, temp_bytes, &bytes);
   // The render's own film, or the one it adds into (options.device_film).
   auto film_memory = ex.alloc(options.device_film ? 0 : film_floats * sizeof(float), "wave allocation");
   float* film = options.device_film ? options.device_film : reinterpret_cast<float*>(film_memory.get());
