@@ -5,6 +5,7 @@
 #include <climits>
 #include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 #include "app/cluster.hpp"
 #include "app/cluster_launch.hpp"
@@ -112,7 +113,8 @@ class MpiTransport final : public Cluster::Transport {
 bool built_with_mpi() { return true; }
 
 Cluster start_cluster(int* argc, char*** argv) {
-  if (launched_ranks() == 1) return Cluster();
+  const int launched = launched_ranks();
+  if (launched == 1) return Cluster();
   // The batch's lanes ask for jobs from threads of their own.
   int provided = 0;
   check(MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided), "MPI_Init_thread");
@@ -125,6 +127,13 @@ Cluster start_cluster(int* argc, char*** argv) {
   int rank = 0, ranks = 1, local_rank = 0, local_ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  if (launched > 1 && ranks != launched) {
+    // Tasks started without the launcher's MPI wiring (srun without --mpi) each see
+    // themselves alone, and would each render and write the whole image.
+    throw std::runtime_error("MPI: started as one of " + std::to_string(launched) + " tasks, but MPI sees " +
+                             std::to_string(ranks) + " rank" + (ranks == 1 ? "" : "s") +
+                             " (under Slurm, srun needs --mpi=pmix or the MPI plugin Slurm was built with)");
+  }
   MPI_Comm host_comm;
   check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &host_comm),
         "MPI_Comm_split_type");

@@ -54,12 +54,12 @@ class MpiCommand : public testing::Test {
   int shell(std::string line) {
     for (size_t at; (at = line.find("{W}")) != std::string::npos;) line.replace(at, 3, "'" + g_wavetrace + "'");
     // Containers run tests as root, which Open MPI refuses unless told. Under
-    // AddressSanitizer the ranks' leak check is off: Open MPI leaves its own
-    // allocations at MPI_Finalize, some made by components it has unloaded by then,
-    // which no suppression can name; the code the ranks run is the one the rest of
-    // the suite checks for leaks in a single process.
-    const bool ranks = line.rfind("mpirun", 0) == 0;
-    const std::string leaks = ranks && wt::test::kAddressSanitizer ? "ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" " : "";
+    // AddressSanitizer the leak check of processes that start MPI is off: Open MPI
+    // leaves its own allocations at MPI_Finalize, some made by components it has
+    // unloaded by then, which no suppression can name; the code the ranks run is the
+    // one the rest of the suite checks for leaks in a single process.
+    const bool mpi = line.rfind("mpirun", 0) == 0 || line.find("SLURM_STEP_NUM_TASKS") != std::string::npos;
+    const std::string leaks = mpi && wt::test::kAddressSanitizer ? "ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" " : "";
     const std::string command = "cd '" + dir_.string() +
                                 "' && OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
                                 "OMPI_MCA_rmaps_base_oversubscribe=1 " +
@@ -145,6 +145,12 @@ TEST_F(MpiCommand, AFailingRankFailsTheRunSayingWhichAndWhyAndNoImageIsWritten) 
 
   // Rank 2 is killed while the others render: the run fails, with no image.
   EXPECT_NE(shell("mpirun -n 2 {W} render " + options + " : -n 1 sh -c 'kill -KILL $$'"), 0) << err_;
+  EXPECT_FALSE(fs::exists(path("out.png")));
+
+  // Tasks a launcher started without MPI's wiring (Slurm's srun without --mpi) each
+  // see one rank: refused, rather than each rendering and writing the whole image.
+  EXPECT_EQ(shell("env SLURM_STEP_NUM_TASKS=2 {W} render " + options), 1) << err_;
+  EXPECT_NE(err_.find("started as one of 2 tasks, but MPI sees 1 rank"), std::string::npos) << err_;
   EXPECT_FALSE(fs::exists(path("out.png")));
 
   // Checkpoints are one process's: refused, by rank 0 for every rank.
