@@ -60,6 +60,8 @@ TEST(DescribeFailures, RanksFailingAlikeShareOneClause) {
             "rank 2 of 3 (node3): s.json: cannot open scene file");
   EXPECT_EQ(describe_failures({{0, "a", 1, "CUDA error: x"}, {1, "a", 2, "bad"}, {3, "b", 1, "CUDA error: x"}}, 4),
             "ranks 0, 3 of 4 (a, b): CUDA error: x; rank 1 of 4 (a): bad");
+  // Hosts are named whole: one whose name holds another's is still named.
+  EXPECT_EQ(describe_failures({{0, "node12", 1, "x"}, {1, "node1", 1, "x"}}, 2), "ranks 0, 1 of 2 (node12, node1): x");
 }
 
 TEST(Cluster, OfOneProcessExchangesWithItselfAlone) {

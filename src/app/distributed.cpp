@@ -6,6 +6,8 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 
+#include "app/stats.hpp"
+
 namespace wt::app {
 
 using nlohmann::json;
@@ -52,13 +54,15 @@ std::string describe_failures(const std::vector<RankStatus>& failed, int ranks) 
   for (const std::string& message : order) {
     const std::vector<const RankStatus*>& list = by_message[message];
     std::string who = list.size() == 1 ? "rank " : "ranks ";
-    std::string hosts;
+    std::vector<std::string> hosts;
     for (size_t i = 0; i < list.size(); ++i) {
       who += (i ? ", " : "") + std::to_string(list[i]->rank);
-      if (hosts.find(list[i]->host) == std::string::npos) hosts += (hosts.empty() ? "" : ", ") + list[i]->host;
+      if (std::find(hosts.begin(), hosts.end(), list[i]->host) == hosts.end()) hosts.push_back(list[i]->host);
     }
+    std::string named;
+    for (const std::string& h : hosts) named += (named.empty() ? "" : ", ") + h;
     line += (line.empty() ? "" : "; ") + who + " of " + std::to_string(ranks) +
-            (hosts.empty() ? "" : " (" + hosts + ")") + ": " + message;
+            (named.empty() ? "" : " (" + named + ")") + ": " + message;
   }
   return line;
 }
@@ -147,14 +151,21 @@ void combine_results(const Cluster& cluster, JobOutcome& out) {
   const RenderResult& r = out.result;
   json mine = status_of(cluster, out);
   if (out.exit_code == 0) {
+    // Its devices' shares; a rank that rendered on one device is one share, unnamed.
     json shares = json::array();
-    for (const DeviceShare& s : r.shares) {
-      shares.push_back({{"device", s.device}, {"name", s.name}, {"samples", s.samples}, {"chunks", s.chunks},
-                        {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}});
+    for (const DeviceShare& s : r.shares) shares.push_back(share_json(s));
+    if (r.shares.empty()) {
+      DeviceShare one;
+      one.name = r.device;
+      one.samples = static_cast<int32_t>(r.paths / (static_cast<uint64_t>(out.params.width) * out.params.height));
+      one.chunks = one.samples > 0 ? 1 : 0;
+      one.seconds = r.seconds;
+      one.rays = r.rays;
+      one.shadow_rays = r.shadow_rays;
+      shares.push_back(share_json(one));
     }
-    mine["result"] = {{"rays", r.rays},       {"shadow_rays", r.shadow_rays}, {"paths", r.paths},
-                      {"seconds", r.seconds}, {"upload_seconds", r.upload_seconds},
-                      {"device", r.device},   {"shares", shares}};
+    mine["result"] = {{"rays", r.rays},       {"shadow_rays", r.shadow_rays},       {"paths", r.paths},
+                      {"seconds", r.seconds}, {"upload_seconds", r.upload_seconds}, {"shares", shares}};
   }
   json decision;
   std::vector<json> statuses;
@@ -174,7 +185,6 @@ void combine_results(const Cluster& cluster, JobOutcome& out) {
   whole.radiance = Radiance::SumOfSamples;
   whole.samples = out.params.spp;
   whole.device = std::to_string(cluster.ranks()) + " ranks";
-  const uint64_t pixels = static_cast<uint64_t>(out.params.width) * out.params.height;
   for (size_t rank = 0; rank < statuses.size(); ++rank) {
     const json& s = statuses[rank]["result"];
     const std::string who = "rank " + std::to_string(rank) + " (" + statuses[rank].value("host", "") + ")";
@@ -183,26 +193,9 @@ void combine_results(const Cluster& cluster, JobOutcome& out) {
     whole.paths += s.value("paths", uint64_t(0));
     whole.seconds = std::max(whole.seconds, s.value("seconds", 0.0));
     whole.upload_seconds = std::max(whole.upload_seconds, s.value("upload_seconds", 0.0));
-    if (s["shares"].empty()) {
-      DeviceShare d;
-      d.device = who;
-      d.name = s.value("device", "");
-      d.samples = static_cast<int32_t>(s.value("paths", uint64_t(0)) / pixels);
-      d.chunks = d.samples > 0 ? 1 : 0;
-      d.seconds = s.value("seconds", 0.0);
-      d.rays = s.value("rays", uint64_t(0));
-      d.shadow_rays = s.value("shadow_rays", uint64_t(0));
-      whole.shares.push_back(d);
-    }
     for (const json& j : s["shares"]) {
-      DeviceShare d;
-      d.device = who + " " + j.value("device", "");
-      d.name = j.value("name", "");
-      d.samples = j.value("samples", 0);
-      d.chunks = j.value("chunks", 0);
-      d.seconds = j.value("seconds", 0.0);
-      d.rays = j.value("rays", uint64_t(0));
-      d.shadow_rays = j.value("shadow_rays", uint64_t(0));
+      DeviceShare d = share_of(j);
+      d.device = d.device.empty() ? who : who + " " + d.device;
       whole.shares.push_back(d);
     }
   }

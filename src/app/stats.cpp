@@ -47,6 +47,23 @@ nlohmann::json geometry_json(const Scene::Summary& g) {
   return j;
 }
 
+nlohmann::json share_json(const DeviceShare& s) {
+  return {{"device", s.device}, {"name", s.name},         {"samples", s.samples},        {"chunks", s.chunks},
+          {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}};
+}
+
+DeviceShare share_of(const nlohmann::json& j) {
+  DeviceShare s;
+  s.device = j.value("device", "");
+  s.name = j.value("name", "");
+  s.samples = j.value("samples", 0);
+  s.chunks = j.value("chunks", 0);
+  s.seconds = j.value("seconds", 0.0);
+  s.rays = j.value("rays", uint64_t(0));
+  s.shadow_rays = j.value("shadow_rays", uint64_t(0));
+  return s;
+}
+
 void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load) {
   j["rays"] = r.rays;
   j["shadow_rays"] = r.shadow_rays;  // light sampling's, not in `rays`
@@ -64,10 +81,7 @@ void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, 
   j["rays_per_path"] = r.paths ? static_cast<double>(r.rays) / r.paths : 0.0;
   if (!r.shares.empty()) {
     nlohmann::json devices = nlohmann::json::array();
-    for (const DeviceShare& s : r.shares) {
-      devices.push_back({{"device", s.device}, {"name", s.name}, {"samples", s.samples}, {"chunks", s.chunks},
-                         {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}});
-    }
+    for (const DeviceShare& s : r.shares) devices.push_back(share_json(s));
     j["devices"] = devices;
   }
   if (!r.stages.empty()) {

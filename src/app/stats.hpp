@@ -16,6 +16,11 @@ nlohmann::json settings_json(const RenderParams& params);
 // the stage times and live paths per bounce.
 void add_measurements(nlohmann::json& j, const RenderResult& r, double seconds, const LoadTimes& load);
 
+// What one device did in a split render, as the stats' "devices" list holds it (and
+// as the ranks of an MPI run send it to rank 0), and back.
+nlohmann::json share_json(const DeviceShare& share);
+DeviceShare share_of(const nlohmann::json& j);
+
 // The scene's geometry: counts, dropped triangles, BVH shapes and costs.
 nlohmann::json geometry_json(const Scene::Summary& geometry);
 
