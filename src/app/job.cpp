@@ -160,10 +160,6 @@ void recover_device(JobOutcome& out) {
   if (out.device_lost) out.message += "; " + std::string(cuda::kContextLost);
 }
 
-}  // namespace
-
-namespace {
-
 // Runs one phase of a job: its errors become the outcome's exit code and message.
 template <class F>
 void guarded(JobOutcome& out, F&& phase) {
@@ -261,12 +257,8 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
                          " MPI ranks has none (render its parts as jobs of a batch instead)");
       }
       if (options.backend == Backend::Cuda) {
-        // The ranks of one host share its GPUs out.
-        std::vector<int> devices = options.devices;
-        if (devices.empty()) {
-          for (int d = 0; d < cuda::device_count(); ++d) devices.push_back(d);
-        }
-        options.devices = local_share(devices, cluster.local_rank(), cluster.local_ranks());
+        // The ranks of one host share its GPUs out (parse_devices lists them all for "all").
+        options.devices = local_share(options.devices, cluster.local_rank(), cluster.local_ranks());
       } else if (options.threads == 0) {
         // The ranks of one host share its cores out.
         options.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / cluster.local_ranks());

@@ -1,7 +1,9 @@
 // One render over several devices (the GPUs of a host, or host "devices" of the CPU
 // backend): its samples are cut into chunks (the passes the render would make on one
 // device), handed to the devices as they free up, so that a faster or less busy
-// device takes more of them, and folded into the film in the chunks' order. The
+// device takes more of them. Each device keeps its chunks' sums and the devices'
+// sums are added in device order; where after_pass must see the film after every
+// chunk, the chunks are folded into the film in their order instead. The
 // counter-based random numbers make a path's value independent of where it runs, so
 // the image is the one-device image up to the order of float additions.
 #pragma once
@@ -26,7 +28,7 @@ namespace wt {
 // Chunks a device gets at least, on average: enough for a faster device to take more.
 constexpr int kChunksPerDevice = 4;
 // At least as many chunks as the CUDA megakernel makes passes on one device: for two
-// devices the chunks are its passes, and its image is the same to the bit.
+// devices the chunks are its passes (progress then moves as often as on one device).
 constexpr int kMinChunks = 10;
 
 // Throws SceneError naming the first index that is not one of the `present` CUDA
