@@ -1,7 +1,8 @@
-// `wavetrace batch` runs each job as `wavetrace render` in a process of its own
-// (run_batch_in_processes). Here: a job becomes a command line that parses back into
-// the same job, and the batch's handling of its children, with small shell scripts
-// standing in for the program (tests/command/ runs the real binary).
+// `wavetrace batch` runs its jobs in processes of its own (run_batch_in_processes): a
+// worker per lane that renders job after job, or `wavetrace render` for each job.
+// Here: a job becomes a command line that parses back into the same job, and the
+// batch's handling of its children, with small shell scripts standing in for the
+// program (tests/command/ runs the real binary).
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
@@ -12,6 +13,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <tuple>
 
 #include "app/batch.hpp"
@@ -99,10 +102,11 @@ class BatchProcessTest : public testing::Test {
   // Runs the batch with the script; its exit code, and what it wrote to stdout and stderr.
   std::tuple<int, std::string, std::string> batch(const std::string& exe, const std::vector<PlannedJob>& list,
                                                   bool skip_done = false,
-                                                  const std::vector<std::string>& lanes = {""}) const {
+                                                  const std::vector<std::string>& lanes = {""},
+                                                  JobProcesses processes = JobProcesses::PerJob) const {
     testing::internal::CaptureStdout();
     testing::internal::CaptureStderr();
-    const int code = run_batch_in_processes(list, skip_done, exe, lanes);
+    const int code = run_batch_in_processes(list, skip_done, exe, lanes, Cluster(), processes);
     std::string out = testing::internal::GetCapturedStdout();
     return {code, out, testing::internal::GetCapturedStderr()};
   }
@@ -236,6 +240,97 @@ while :; do sleep 1; done)");
   EXPECT_NE(out.find("1 jobs: 0 ok, 1 failed; interrupted, 2 not run"), std::string::npos) << out;
 
   std::tie(code, out, err) = batch(script("kill -TERM $PPID\nwhile :; do sleep 1; done"), jobs(3));
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_NE(out.find("FAILED: the job's process was killed by SIGTERM"), std::string::npos) << out;
+  EXPECT_NE(out.find("interrupted, 2 not run"), std::string::npos) << out;
+}
+
+// Shell scripts standing in for `wavetrace worker`: each reads its questions, a line
+// each, logs "PID ..." for each, and answers on descriptor 3.
+TEST_F(BatchProcessTest, AWorkerPerLaneRendersItsJobsOneAfterAnother) {
+  const std::string log = (dir_ / "log").string();
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+while read -r line; do
+  i=$(printf '%s' "$line" | sed 's/.*"index":\([0-9]*\).*/\1/')
+  d=$(printf '%s' "$line" | sed -n 's/.*"--devices=\([0-9,]*\)".*/\1/p')
+  echo "$$ $d" >> ")sh" + log + R"sh("
+  echo "{\"index\":$i,\"exit_code\":0,\"backend\":\"cpu\",\"kernel\":\"wavefront\",\"width\":7,\"height\":5,\"spp\":3,\"depth\":2,\"seconds\":2.0,\"rays\":8000000}" >&3
+done)sh");
+  auto [code, out, err] = batch(exe, jobs(3), false, {""}, JobProcesses::PerLane);
+  EXPECT_EQ(code, 0) << out << err;
+  EXPECT_NE(out.find("3 jobs: 3 ok, 0 failed"), std::string::npos) << out;
+  EXPECT_EQ(count(out, "7x5 3spp d2"), 3u) << out;
+  EXPECT_EQ(count(out, "cpu/wavefront"), 3u) << out;
+  EXPECT_EQ(count(out, "    2.000       4.00  ok -> "), 3u) << out;
+  std::ifstream in(log);
+  std::vector<std::string> seen;
+  for (std::string l; std::getline(in, l);) seen.push_back(l);
+  ASSERT_EQ(seen.size(), 3u);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), seen[0]), 3) << "one worker for the three jobs";
+
+  // Two lanes: a worker each, each with its lane's devices.
+  fs::remove(log);
+  std::tie(code, out, err) = batch(exe, jobs(6), false, {"0", "1"}, JobProcesses::PerLane);
+  EXPECT_EQ(code, 0) << out << err;
+  EXPECT_NE(out.find("6 jobs: 6 ok, 0 failed"), std::string::npos) << out;
+  std::ifstream again(log);
+  std::map<std::string, std::set<std::string>> devices_of;  // worker pid -> the devices its jobs named
+  int jobs_seen = 0;
+  for (std::string pid, devices; again >> pid >> devices; ++jobs_seen) devices_of[pid].insert(devices);
+  EXPECT_EQ(jobs_seen, 6);
+  EXPECT_LE(devices_of.size(), 2u);
+  for (const auto& [pid, devices] : devices_of) EXPECT_EQ(devices.size(), 1u) << "worker " << pid;
+}
+
+// A job that lost the CUDA context, a worker killed mid-job and one that exits
+// without answering: each fails its job alone, and the lane's next job starts a new
+// worker, which renders it.
+TEST_F(BatchProcessTest, AJobThatEndsItsWorkerFailsAloneAndTheNextStartsANewOne) {
+  const std::string log = (dir_ / "log").string();
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+while read -r line; do
+  i=$(printf '%s' "$line" | sed 's/.*"index":\([0-9]*\).*/\1/')
+  echo "$$ $i" >> ")sh" + log + R"sh("
+  case $i in
+    0) echo "{\"index\":0,\"exit_code\":1,\"message\":\"cuda: illegal address\",\"device_lost\":true}" >&3; exit 1;;
+    2) kill -SEGV $$;;
+    4) exit 3;;
+    *) echo "{\"index\":$i,\"exit_code\":0,\"backend\":\"cpu\",\"kernel\":\"megakernel\"}" >&3;;
+  esac
+done)sh");
+  const auto [code, out, err] = batch(exe, jobs(6), false, {""}, JobProcesses::PerLane);
+  EXPECT_EQ(code, kExitFailure) << out << err;
+  EXPECT_NE(out.find("6 jobs: 3 ok, 3 failed"), std::string::npos) << out;
+  EXPECT_EQ(count(out, "FAILED: cuda: illegal address"), 1u) << out;
+  EXPECT_EQ(count(out, "FAILED: the job's process was killed by signal " + std::to_string(SIGSEGV) + " (" +
+                           strsignal(SIGSEGV) + ")"),
+            1u)
+      << out;
+  EXPECT_EQ(count(out, "FAILED: the job's process exited with 3 without saying why"), 1u) << out;
+  EXPECT_EQ(count(err, "wavetrace: cuda: illegal address\n"), 1u) << err;
+  // Workers: {0}, {1, 2}, {3, 4}, {5}.
+  std::ifstream in(log);
+  std::vector<std::pair<std::string, int>> seen;
+  std::string pid;
+  for (int i = 0; in >> pid >> i;) seen.emplace_back(pid, i);
+  ASSERT_EQ(seen.size(), 6u);
+  std::set<std::string> pids;
+  for (const auto& p : seen) pids.insert(p.first);
+  EXPECT_EQ(pids.size(), 4u);
+  EXPECT_NE(seen[0].first, seen[1].first);
+  EXPECT_EQ(seen[1].first, seen[2].first);
+  EXPECT_NE(seen[2].first, seen[3].first);
+  EXPECT_EQ(seen[3].first, seen[4].first);
+  EXPECT_NE(seen[4].first, seen[5].first);
+}
+
+// SIGTERM sent to the batch reaches the worker rendering a job; the batch stops.
+TEST_F(BatchProcessTest, SigtermToTheBatchReachesTheWorkerAndStopsTheBatch) {
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+read -r line
+kill -TERM $PPID
+while :; do sleep 1; done)sh");
+  const auto [code, out, err] = batch(exe, jobs(3), false, {""}, JobProcesses::PerLane);
   EXPECT_EQ(code, 128 + SIGTERM);
   EXPECT_NE(out.find("FAILED: the job's process was killed by SIGTERM"), std::string::npos) << out;
   EXPECT_NE(out.find("interrupted, 2 not run"), std::string::npos) << out;

@@ -7,7 +7,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -113,8 +115,8 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
 
 namespace {
 
-// Runs one job of a batch: its outcome, whose message the batch prints.
-using JobRunner = std::function<JobOutcome(size_t index, const Job& job)>;
+// Runs one job of a batch in lane `lane`: its outcome, whose message the batch prints.
+using JobRunner = std::function<JobOutcome(size_t lane, size_t index, const Job& job)>;
 
 // The job as a lane runs it: on the lane's CUDA devices ("": the job's own), without
 // a progress line where lanes run at once.
@@ -189,10 +191,10 @@ class BatchRun {
 
   // A lane of this process: runs jobs with `run` until none is left. `devices`: the
   // lane's CUDA devices ("": the job's own); `quiet`: no progress lines (lanes at once).
-  void lane(const JobRunner& run, const std::string& devices, bool quiet) {
+  void lane(const JobRunner& run, size_t lane_index, const std::string& devices, bool quiet) {
     while (const std::optional<size_t> i = take(devices.empty() ? "" : "cuda " + devices)) {
       if (settle(*i)) continue;
-      record(*i, run(*i, lane_job(jobs_[*i].job, devices, quiet)));
+      record(*i, run(lane_index, *i, lane_job(jobs_[*i].job, devices, quiet)));
     }
   }
 
@@ -248,10 +250,10 @@ int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunne
              const std::function<int()>& signal_caught, const std::vector<std::string>& lanes = {""}) {
   BatchRun batch(jobs, skip_done, signal_caught);
   if (lanes.size() <= 1) {
-    batch.lane(run, lanes.empty() ? std::string() : lanes[0], false);
+    batch.lane(run, 0, lanes.empty() ? std::string() : lanes[0], false);
   } else {
     std::vector<std::thread> threads;
-    for (const std::string& devices : lanes) threads.emplace_back([&, devices] { batch.lane(run, devices, true); });
+    for (size_t l = 0; l < lanes.size(); ++l) threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], true); });
     for (std::thread& t : threads) t.join();
   }
   return batch.summary();
@@ -267,6 +269,17 @@ void read_measurements(const std::string& path, JobOutcome& o) {
   o.kernel = j.value("kernel", "");
   o.result.seconds = j.value("seconds", 0.0);
   o.result.rays = j.value("rays", uint64_t(0));
+}
+
+// A job whose process a signal killed: a signal the batch passed on stops the batch,
+// as a job interrupted after its checkpoint does; any other signal fails this job alone.
+void killed(const ChildEnd& end, const SignalForwarder& signals, JobOutcome& o) {
+  o.exit_code = end.signal == signals.caught() ? 128 + end.signal : kExitFailure;
+  o.message = "the job's process was killed by " + signal_name(end.signal);
+}
+
+std::string exited_silently(int code) {
+  return "the job's process exited with " + std::to_string(code) + " without saying why";
 }
 
 // Runs one job as `wavetrace render` in a process of its own.
@@ -295,14 +308,10 @@ JobOutcome run_job_in_process(const std::string& executable, size_t index, const
       read_measurements(child_job.stats, o);
       if (!end.last_line.empty()) std::fprintf(stderr, "wavetrace: %s\n", end.last_line.c_str());
     } else if (o.message.empty()) {
-      o.message = "the job's process exited with " + std::to_string(o.exit_code) + " without saying why";
+      o.message = exited_silently(o.exit_code);
     }
   } else {
-    // A signal the batch passed on stops the batch, as a job interrupted after its
-    // checkpoint does; any other signal fails this job alone.
-    const bool passed_on = end.signal == signals.caught();
-    o.exit_code = passed_on ? 128 + end.signal : kExitFailure;
-    o.message = "the job's process was killed by " + signal_name(end.signal);
+    killed(end, signals, o);
   }
   if (child_job.stats != job.stats) {
     std::error_code ignored;
@@ -317,7 +326,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done) {
   // A sticky error poisons this process's CUDA context for good: the CUDA jobs after
   // it fail at once, the CPU jobs still run.
   std::string lost_in;
-  const JobRunner run = [&](size_t index, const Job& job) {
+  const JobRunner run = [&](size_t, size_t index, const Job& job) {
     if (!lost_in.empty() && job.backend != "cpu") {
       JobOutcome o;
       o.exit_code = kExitFailure;
@@ -361,7 +370,7 @@ json outcome_json(size_t index, const JobOutcome& o) {
   return json{{"index", index},        {"exit_code", o.exit_code},        {"message", o.message},
               {"backend", o.backend},  {"kernel", o.kernel},              {"width", o.params.width},
               {"height", o.params.height}, {"spp", o.params.spp},         {"depth", o.params.depth},
-              {"seconds", o.result.seconds}, {"rays", o.result.rays}};
+              {"seconds", o.result.seconds}, {"rays", o.result.rays},     {"device_lost", o.device_lost}};
 }
 
 JobOutcome outcome_of(const json& j) {
@@ -376,6 +385,42 @@ JobOutcome outcome_of(const json& j) {
   o.params.depth = j.value("depth", 0);
   o.result.seconds = j.value("seconds", 0.0);
   o.result.rays = j.value("rays", uint64_t(0));
+  o.device_lost = j.value("device_lost", false);
+  return o;
+}
+
+// Runs one job in the lane's worker (`wavetrace worker`, run_batch_worker). A job
+// that lost the worker's CUDA context, or that a signal interrupted, ends the worker
+// (the next job starts a new one); so does a worker that dies, failing its job alone.
+JobOutcome run_job_in_worker(WorkerProcess& worker, size_t index, const Job& job, const SignalForwarder& signals) {
+  JobOutcome o;
+  ChildEnd end;
+  std::optional<std::string> answer;
+  try {
+    answer = worker.ask(json{{"index", index}, {"args", render_arguments(job)}}.dump(), end);
+  } catch (const std::exception& e) {
+    o.exit_code = kExitFailure;
+    o.message = e.what();
+    return o;
+  }
+  if (answer) {
+    const json said = json::parse(*answer, nullptr, false);
+    if (said.is_object() && said.value("index", index + 1) == index) {
+      o = outcome_of(said);
+      if (o.device_lost || o.exit_code >= 128) worker.stop();
+      return o;
+    }
+    end = worker.stop();
+    o.exit_code = kExitFailure;
+    o.message = "the job's process answered what it was not asked: " + answer->substr(0, 200);
+    return o;
+  }
+  if (end.exited) {
+    o.exit_code = end.exit_code == 0 ? kExitFailure : end.exit_code;
+    o.message = exited_silently(end.exit_code);
+  } else {
+    killed(end, signals, o);
+  }
   return o;
 }
 
@@ -413,7 +458,7 @@ void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool
     const size_t index = given["index"].get<size_t>();
     JobOutcome o;
     try {
-      o = run(index, lane_job(parse_render_arguments(given["args"].get<std::vector<std::string>>()), devices, quiet));
+      o = run(static_cast<size_t>(tag), index, lane_job(parse_render_arguments(given["args"].get<std::vector<std::string>>()), devices, quiet));
     } catch (const std::exception& e) {
       o.exit_code = kExitFailure;
       o.message = std::string("rank ") + std::to_string(cluster.rank()) + " could not take the job: " + e.what();
@@ -427,10 +472,14 @@ void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool
 }  // namespace
 
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
-                           const std::vector<std::string>& lanes, const Cluster& cluster) {
+                           const std::vector<std::string>& lanes, const Cluster& cluster, JobProcesses processes) {
   const SignalForwarder signals;
-  const JobRunner run = [&](size_t index, const Job& job) {
-    return run_job_in_process(executable, index, job, signals);
+  // A worker per lane (made before the lanes start, ended before the forwarder).
+  std::vector<std::unique_ptr<WorkerProcess>> workers;
+  for (size_t l = 0; l < lanes.size(); ++l) workers.push_back(std::make_unique<WorkerProcess>(executable));
+  const JobRunner run = [&](size_t lane, size_t index, const Job& job) {
+    return processes == JobProcesses::PerJob ? run_job_in_process(executable, index, job, signals)
+                                             : run_job_in_worker(*workers.at(lane), index, job, signals);
   };
   if (!cluster.distributed()) return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes);
 
@@ -449,10 +498,40 @@ int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, 
   size_t remote_lanes = 0;
   for (size_t r = 1; r < counts.size(); ++r) remote_lanes += std::stoul(counts[r]);
   BatchRun batch(jobs, skip_done, [&] { return signals.caught(); });
-  for (const std::string& devices : lanes) threads.emplace_back([&, devices] { batch.lane(run, devices, quiet); });
+  for (size_t l = 0; l < lanes.size(); ++l) threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], quiet); });
   serve_ranks(cluster, batch, remote_lanes);
   for (std::thread& t : threads) t.join();
   return batch.summary();
+}
+
+int run_batch_worker(int answers) {
+  FILE* out = ::fdopen(answers, "w");
+  if (!out) {
+    std::fprintf(stderr, "wavetrace: worker: descriptor %d is not open for answers (the worker is started by wavetrace batch)\n", answers);
+    return kExitFailure;
+  }
+  for (std::string line; std::getline(std::cin, line);) {
+    const json asked = json::parse(line, nullptr, false);
+    const size_t index = asked.is_object() ? asked.value("index", size_t(0)) : 0;
+    JobOutcome o;
+    try {
+      const Job job = parse_render_arguments(asked.at("args").get<std::vector<std::string>>());
+      o = run_job(job);
+      if (o.exit_code == 0) print_outcome(job, o);
+    } catch (const std::exception& e) {
+      o.exit_code = kExitBadInput;
+      o.message = std::string("the worker could not read its job: ") + e.what();
+    }
+    std::fflush(stderr);
+    if (std::fputs((outcome_json(index, o).dump() + "\n").c_str(), out) < 0 || std::fflush(out) != 0) {
+      return kExitFailure;  // the batch is gone
+    }
+    // A lost CUDA context stays lost in this process; an interrupted job stops the batch.
+    if (o.device_lost) return kExitFailure;
+    if (o.exit_code >= 128) return o.exit_code;
+  }
+  std::fclose(out);
+  return 0;
 }
 
 void release_ranks(const Cluster& cluster) {

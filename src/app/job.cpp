@@ -364,4 +364,19 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   return out;
 }
 
+void print_outcome(const Job& job, const JobOutcome& o) {
+  const RenderResult& r = o.result;
+  std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
+               o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
+               static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);
+  if (o.ranks > 1) {
+    std::fprintf(stderr, "  %d ranks: %.3f s wall clock from every rank's start to the summed film\n", o.ranks,
+                 o.wall_seconds);
+  }
+  for (const DeviceShare& s : r.shares) {
+    std::fprintf(stderr, "  %s (%s): %d spp in %d chunks, %.3f s, %.1f M rays/s\n", s.device.c_str(), s.name.c_str(),
+                 s.samples, s.chunks, s.seconds, s.seconds > 0 ? s.rays / s.seconds / 1e6 : 0.0);
+  }
+}
+
 }  // namespace wt::app

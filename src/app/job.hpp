@@ -67,6 +67,9 @@ struct JobOutcome {
 // device fit for the next job (cuda::recover_after_error); after a sticky one it says
 // that the context cannot be recovered and sets device_lost.
 JobOutcome run_job(const Job& job);
+// Prints what `render` says of a job that rendered (to stderr): its result line, and a
+// line for each of its ranks and devices where it had several.
+void print_outcome(const Job& job, const JobOutcome& o);
 // The same job as one rank of an MPI run (app/distributed.hpp): every rank calls it;
 // rank 0 alone writes, and every rank's outcome fails where any rank's part did.
 JobOutcome run_job(const Job& job, const Cluster& cluster);

@@ -55,6 +55,12 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   batch->add_option("--output-dir", output_dir, "where scene files given directly are rendered to");
   bool skip_done = false;
   batch->add_flag("--resume", skip_done, "skip the jobs whose image exists (a batch resumed)");
+  bool process_per_job = false;
+  batch->add_flag("--process-per-job", process_per_job,
+                  "run each job in a process of its own (a clean CUDA context for every job) rather than in "
+                  "a worker process per lane (set up once, replaced after a job that loses its context)");
+  // The process a batch lane keeps (app/batch.hpp); not for the command line.
+  CLI::App* worker = app.add_subcommand("worker", "")->group("");
   wt::app::add_render_options(*batch, batch_job, batch_encoding);
 
   wt::app::BenchOptions bench_options;
@@ -88,6 +94,8 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     return wt::app::kExitBadInput;
   }
 
+  if (*worker) return wt::app::run_batch_worker();
+
   if (*render) {
     Job job = render_command.parsed();
     if (!cluster.root()) job.progress = false;
@@ -98,18 +106,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
       return o.exit_code;
     }
     if (!cluster.root()) return 0;
-    const wt::RenderResult& r = o.result;
-    std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
-                 o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
-                 static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);
-    if (o.ranks > 1) {
-      std::fprintf(stderr, "  %d ranks: %.3f s wall clock from every rank's start to the summed film\n", o.ranks,
-                   o.wall_seconds);
-    }
-    for (const wt::DeviceShare& s : r.shares) {
-      std::fprintf(stderr, "  %s (%s): %d spp in %d chunks, %.3f s, %.1f M rays/s\n", s.device.c_str(),
-                   s.name.c_str(), s.samples, s.chunks, s.seconds, s.seconds > 0 ? s.rays / s.seconds / 1e6 : 0.0);
-    }
+    wt::app::print_outcome(job, o);
     return 0;
   }
 
@@ -135,6 +132,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   }
 
   wt::app::set_encoding(batch_job, batch_encoding);
+  const auto processes = process_per_job ? wt::app::JobProcesses::PerJob : wt::app::JobProcesses::PerLane;
   // Its jobs render alone, whatever MPI run the batch is a rank of.
   if (cluster.distributed()) setenv(wt::app::kSingleProcessVariable, "1", 1);
   std::vector<wt::app::PlannedJob> jobs;
@@ -146,7 +144,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     } catch (const wt::SceneError&) {
       lanes = {""};  // rank 0 reads the same list, and says what is wrong with it
     }
-    return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster);
+    return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster, processes);
   }
   try {
     // One input that is a jobs file; otherwise every input is a scene file.
@@ -176,7 +174,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
   }
-  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster);
+  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster, processes);
 }
 
 }  // namespace

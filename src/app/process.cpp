@@ -6,12 +6,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 extern char** environ;
 
@@ -156,16 +159,42 @@ SignalForwarder::~SignalForwarder() {
 
 int SignalForwarder::caught() const { return g_caught; }
 
-ChildEnd run_child(const std::string& executable, const std::vector<std::string>& args) {
+namespace {
+
+// A pipe whose ends are at descriptors 10 and up, close-on-exec: a child gets an end
+// only where it is dup2'ed into place (which clears close-on-exec there; an end that
+// already sat at the target descriptor would keep it).
+std::array<int, 2> high_pipe() {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error(std::string("cannot make a pipe: ") + std::strerror(errno));
+  std::array<int, 2> out{};
+  for (int i = 0; i < 2; ++i) {
+    out[i] = ::fcntl(fds[i], F_DUPFD_CLOEXEC, 10);
+    const int err = errno;
+    ::close(fds[i]);
+    if (out[i] < 0) {
+      if (i == 1) ::close(out[0]);
+      throw std::runtime_error(std::string("cannot make a pipe: ") + std::strerror(err));
+    }
+  }
+  return out;
+}
+
+// Starts `executable` with `args` (argv[0] "wavetrace") in a process group of its own,
+// with `moves` (from, to) dup2'ed into place and SIGPIPE at its default; its pid.
+pid_t spawn(const std::string& executable, const std::vector<std::string>& args,
+            const std::vector<std::pair<int, int>>& moves) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, fds[1], STDERR_FILENO);
+  for (const auto& [from, to] : moves) posix_spawn_file_actions_adddup2(&actions, from, to);
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGDEF);
   posix_spawnattr_setpgroup(&attr, 0);
+  sigset_t defaults;
+  sigemptyset(&defaults);
+  sigaddset(&defaults, SIGPIPE);
+  posix_spawnattr_setsigdefault(&attr, &defaults);
 
   std::vector<std::string> argv_text = {"wavetrace"};
   argv_text.insert(argv_text.end(), args.begin(), args.end());
@@ -177,11 +206,61 @@ ChildEnd run_child(const std::string& executable, const std::vector<std::string>
   const int err = ::posix_spawn(&pid, executable.c_str(), &actions, &attr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
-  ::close(fds[1]);
-  if (err != 0) {
-    ::close(fds[0]);
-    throw std::runtime_error("cannot start " + executable + ": " + std::strerror(err));
+  if (err != 0) throw std::runtime_error("cannot start " + executable + ": " + std::strerror(err));
+  return pid;
+}
+
+// Waits for `pid`; how it ended.
+ChildEnd wait_for(pid_t pid) {
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  ChildEnd end;
+  end.exited = WIFEXITED(status);
+  end.exit_code = end.exited ? WEXITSTATUS(status) : 0;
+  end.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+  return end;
+}
+
+// Writes all of `text` to `fd`; false if the reader is gone (EPIPE, whose SIGPIPE is
+// held back from this thread and taken here, so that it ends nothing).
+bool write_or_gone(int fd, const std::string& text) {
+  sigset_t pipe_signal, previous;
+  sigemptyset(&pipe_signal);
+  sigaddset(&pipe_signal, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe_signal, &previous);
+  bool gone = false;
+  for (size_t at = 0; at < text.size();) {
+    const ssize_t k = ::write(fd, text.data() + at, text.size() - at);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) {
+      gone = true;
+      break;
+    }
+    at += static_cast<size_t>(k);
+  }
+  if (gone && !sigismember(&previous, SIGPIPE)) {
+    const timespec now{0, 0};
+    while (sigtimedwait(&pipe_signal, nullptr, &now) == SIGPIPE) {
+    }
+  }
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  return !gone;
+}
+
+}  // namespace
+
+ChildEnd run_child(const std::string& executable, const std::vector<std::string>& args) {
+  const std::array<int, 2> fds = high_pipe();
+  pid_t pid = 0;
+  try {
+    pid = spawn(executable, args, {{fds[1], STDERR_FILENO}});
+  } catch (...) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw;
+  }
+  ::close(fds[1]);
   const int slot = take_slot();
   set_child(slot, pid);
 
@@ -192,17 +271,74 @@ ChildEnd run_child(const std::string& executable, const std::vector<std::string>
     else if (errno != EINTR) break;
   }
   ::close(fds[0]);
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
+  ChildEnd end = wait_for(pid);
   set_child(slot, 0);
   free_slot(slot);
-
-  ChildEnd end;
   end.last_line = filter.finish();
-  end.exited = WIFEXITED(status);
-  end.exit_code = end.exited ? WEXITSTATUS(status) : 0;
-  end.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+  return end;
+}
+
+WorkerProcess::WorkerProcess(std::string executable) : executable_(std::move(executable)) {}
+
+WorkerProcess::~WorkerProcess() { stop(); }
+
+void WorkerProcess::start() {
+  const std::array<int, 2> to = high_pipe();
+  std::array<int, 2> from{};
+  try {
+    from = high_pipe();
+  } catch (...) {
+    ::close(to[0]);
+    ::close(to[1]);
+    throw;
+  }
+  try {
+    pid_ = spawn(executable_, {"worker"}, {{to[0], STDIN_FILENO}, {from[1], 3}});
+  } catch (...) {
+    for (int fd : {to[0], to[1], from[0], from[1]}) ::close(fd);
+    throw;
+  }
+  ::close(to[0]);
+  ::close(from[1]);
+  to_ = to[1];
+  from_ = from[0];
+  pending_.clear();
+  slot_ = take_slot();
+  set_child(slot_, pid_);
+}
+
+std::optional<std::string> WorkerProcess::ask(const std::string& question, ChildEnd& end) {
+  if (pid_ == 0) start();
+  if (write_or_gone(to_, question + "\n")) {
+    char buf[4096];
+    for (;;) {
+      const size_t newline = pending_.find('\n');
+      if (newline != std::string::npos) {
+        std::string answer = pending_.substr(0, newline);
+        pending_.erase(0, newline + 1);
+        return answer;
+      }
+      const ssize_t k = ::read(from_, buf, sizeof buf);
+      if (k > 0) {
+        pending_.append(buf, static_cast<size_t>(k));
+      } else if (k == 0 || errno != EINTR) {
+        break;
+      }
+    }
+  }
+  end = stop();
+  return std::nullopt;
+}
+
+ChildEnd WorkerProcess::stop() {
+  if (pid_ == 0) return {};
+  ::close(to_);
+  ::close(from_);
+  const ChildEnd end = wait_for(pid_);
+  set_child(slot_, 0);
+  free_slot(slot_);
+  pid_ = 0;
+  slot_ = to_ = from_ = -1;
   return end;
 }
 

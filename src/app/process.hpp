@@ -1,9 +1,13 @@
-// Jobs in processes of their own: `wavetrace batch` runs each job as a `render` of a
-// child process, so that every job starts on a clean CUDA context (a sticky CUDA
-// error poisons the context of the process it happens in, for good) and no job's
-// memory or descriptors can outlive it.
+// Jobs in processes of their own: `wavetrace batch` runs its jobs in child processes,
+// a worker per lane that renders job after job (its CUDA context set up once), or a
+// `render` process for each job; a job that loses the worker's CUDA context (a
+// sticky CUDA error poisons the context of the process it happens in, for good) or
+// kills it ends that worker, and the next job starts a new one.
 #pragma once
 
+#include <sys/types.h>
+
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,5 +42,32 @@ struct ChildEnd {
 // starts with "wavetrace: ", returned. Waits for it. Throws std::runtime_error if it
 // cannot be started.
 ChildEnd run_child(const std::string& executable, const std::vector<std::string>& args);
+
+// `executable worker` in a process group of its own, started at the first question:
+// it answers questions one at a time, each a line to its stdin answered by a line on
+// its descriptor 3; its stdout and stderr are ours. While it lives, the
+// SignalForwarder passes SIGINT and SIGTERM on to it. One thread at a time asks it.
+class WorkerProcess {
+ public:
+  explicit WorkerProcess(std::string executable);
+  ~WorkerProcess();  // stop()
+  WorkerProcess(const WorkerProcess&) = delete;
+  WorkerProcess& operator=(const WorkerProcess&) = delete;
+
+  // Sends `question` (one line, without its newline) and waits for the answer. No
+  // answer: the process ended first (how: in `end`), and the next question starts a
+  // new one. Throws std::runtime_error if it cannot be started.
+  std::optional<std::string> ask(const std::string& question, ChildEnd& end);
+  // Closes its input, which ends it, and waits for it to exit; its end.
+  ChildEnd stop();
+
+ private:
+  void start();
+  std::string executable_;
+  pid_t pid_ = 0;
+  int slot_ = -1;
+  int to_ = -1, from_ = -1;  // its stdin, its answers
+  std::string pending_;      // read past the last answer
+};
 
 }  // namespace wt::app

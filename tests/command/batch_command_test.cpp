@@ -1,6 +1,6 @@
 // `wavetrace batch` through the built program (its path is this binary's first
-// argument; see CMakeLists.txt): good and bad jobs, each in a process of its own, on
-// the CPU, and on CUDA where a device is present.
+// argument; see CMakeLists.txt): good and bad jobs, in the lane's worker process and
+// each in a process of its own, on the CPU, and on CUDA where a device is present.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -60,8 +60,8 @@ class BatchCommand : public testing::Test {
     return n;
   }
 
-  // Good and bad jobs on `backend`; checks what one run of the batch did.
-  void good_and_bad_jobs(const std::string& backend) {
+  // Good and bad jobs on `backend`, the batch run with `flags`; checks what it did.
+  void good_and_bad_jobs(const std::string& backend, const std::string& flags = "") {
     std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": ")" << backend
                                      << R"(", "width": 32, "height": 16, "spp": 2},
       "jobs": [{"scene": "s.json", "output": "a.png", "stats": "a.json"},
@@ -69,7 +69,7 @@ class BatchCommand : public testing::Test {
                {"scene": "s.json", "output": "c.pfm", "kernel": "wavefront", "seed": 7, "depth": 4},
                {"scene": "s.json", "output": "no-such-folder/d.png"},
                {"scene": "s.json", "output": "e.png", "spelling": 1}]})";
-    EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 1) << err_;
+    EXPECT_EQ(batch("'" + path("jobs.json") + "'" + flags), 1) << err_;
     EXPECT_TRUE(fs::exists(path("a.png")));
     EXPECT_TRUE(fs::exists(path("a.json")));
     EXPECT_TRUE(fs::exists(path("c.pfm")));
@@ -91,7 +91,7 @@ class BatchCommand : public testing::Test {
     EXPECT_NE(out_.find("\n5 jobs: 2 ok, 3 failed\n"), std::string::npos) << out_;
 
     // Resumed: the done jobs are skipped, the bad ones fail again.
-    EXPECT_EQ(batch("'" + path("jobs.json") + "' --resume"), 1) << err_;
+    EXPECT_EQ(batch("'" + path("jobs.json") + "' --resume" + flags), 1) << err_;
     EXPECT_EQ(count(out_, "skipped: " + path("a.png") + " exists"), 1u) << out_;
     EXPECT_EQ(count(out_, "skipped: " + path("c.pfm") + " exists"), 1u) << out_;
     EXPECT_NE(out_.find("\n5 jobs: 2 ok, 3 failed\n"), std::string::npos) << out_;
@@ -99,7 +99,7 @@ class BatchCommand : public testing::Test {
     // Scene files given directly, with render options.
     fs::create_directories(dir_ / "renders");
     EXPECT_EQ(batch("'" + path("s.json") + "' --output-dir '" + path("renders") + "' --backend " + backend +
-                    " --width 8 --height 8 --spp 1"),
+                    " --width 8 --height 8 --spp 1" + flags),
               0)
         << err_;
     EXPECT_TRUE(fs::exists(dir_ / "renders" / "s.png"));
@@ -110,11 +110,27 @@ class BatchCommand : public testing::Test {
   std::string out_, err_;
 };
 
-TEST_F(BatchCommand, GoodAndBadJobsOnTheCpuEachInAProcessOfItsOwn) { good_and_bad_jobs("cpu"); }
+// The jobs in the lane's worker process, and each in a process of its own.
+TEST_F(BatchCommand, GoodAndBadJobsOnTheCpuInAWorker) { good_and_bad_jobs("cpu"); }
+TEST_F(BatchCommand, GoodAndBadJobsOnTheCpuEachInAProcessOfItsOwn) { good_and_bad_jobs("cpu", " --process-per-job"); }
+
+TEST_F(BatchCommand, GoodAndBadJobsOnCudaInAWorker) {
+  WT_REQUIRE_CUDA();
+  good_and_bad_jobs("cuda");
+}
 
 TEST_F(BatchCommand, GoodAndBadJobsOnCudaEachInAProcessOfItsOwn) {
   WT_REQUIRE_CUDA();
-  good_and_bad_jobs("cuda");
+  good_and_bad_jobs("cuda", " --process-per-job");
+}
+
+// The worker is the batch's: started by hand, without its answer descriptor, it says so.
+TEST_F(BatchCommand, AWorkerStartedByHandSaysWhatItIs) {
+  const std::string command = "'" + g_wavetrace + "' worker </dev/null 3>&- 2>'" + path("err.txt") + "'";
+  const int status = std::system(command.c_str());
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1);
+  EXPECT_NE(read(path("err.txt")).find("wavetrace: worker: descriptor 3 is not open for answers"), std::string::npos)
+      << read(path("err.txt"));
 }
 
 }  // namespace
