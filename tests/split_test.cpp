@@ -67,14 +67,28 @@ TEST(Split, HostDevicesRenderTheOneDeviceImage) {
       expect_same_image(one, split, false, what);
       ASSERT_EQ(split.shares.size(), devices.size()) << what;
       int samples = 0, chunks = 0;
+      uint64_t paths = 0;
       for (const DeviceShare& s : split.shares) {
-        EXPECT_GT(s.chunks, 0) << what << ": " << s.device << " got no chunk";
+        // The wavefront's devices take blocks of the paths as they ask: one may, by
+        // timing, take none.
+        if (k == Kernel::Megakernel) {
+          EXPECT_GT(s.chunks, 0) << what << ": " << s.device << " got no chunk";
+        }
         samples += s.samples;
         chunks += s.chunks;
+        paths += s.paths;
       }
-      EXPECT_EQ(samples, 12) << what;
-      EXPECT_EQ(chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * static_cast<int>(devices.size()))))
-          << what;
+      EXPECT_EQ(paths, one.paths) << what;
+      if (k == Kernel::Megakernel) {
+        EXPECT_EQ(samples, 12) << what;
+        EXPECT_EQ(chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * static_cast<int>(devices.size()))))
+            << what;
+      } else {
+        // One pass of 64 x 36 x 12 paths in blocks of a 1/(8 x devices) share.
+        const uint64_t share = one.paths / (8 * devices.size());
+        EXPECT_EQ(samples, 0) << what;
+        EXPECT_EQ(static_cast<uint64_t>(chunks), (one.paths + share - 1) / share) << what;
+      }
       EXPECT_TRUE(one.shares.empty());
     }
   }
@@ -212,6 +226,52 @@ TEST(Split, ADeviceThatKeepsItsSumsBringsThemBackOnce) {
   EXPECT_EQ(passes, plain_chunks);
 }
 
+// A path feed hands out each path of each pass once, in blocks of at most what the
+// device asks and a 1/(8 x devices) share of the pass, and nothing once stopped.
+TEST(PathFeedTest, EveryPathOnceInBoundedBlocks) {
+  PathFeed feed(2);
+  std::vector<int> seen(1000, 0);
+  std::vector<PathFeed::Block> blocks;
+  for (;;) {
+    const PathFeed::Block b = feed.take(0, 1000, blocks.size() % 2 ? 40 : 1000);
+    if (b.empty()) break;
+    EXPECT_LE(b.end - b.first, blocks.size() % 2 ? 40u : 62u);  // 1000 / 16
+    for (uint32_t p = b.first; p < b.end; ++p) ++seen[p];
+    blocks.push_back(b);
+  }
+  for (size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << p;
+  for (size_t i = 1; i < blocks.size(); ++i) EXPECT_EQ(blocks[i].first, blocks[i - 1].end);
+  EXPECT_EQ(feed.given(), 1000u);
+  // Another pass counts from its own start.
+  EXPECT_EQ(feed.take(1, 500, 10).first, 0u);
+  EXPECT_EQ(feed.given(), 1010u);
+  feed.stop();
+  EXPECT_TRUE(feed.take(1, 500, 10).empty());
+  EXPECT_TRUE(feed.take(2, 500, 10).empty());
+}
+
+// Two fed host devices over several passes (a lowered path limit per pass) and a
+// resumed range: the image is the one-device image, every path traced once.
+TEST(Split, FedWavefrontDevicesOverSeveralPassesRenderTheOneDeviceImage) {
+  RenderOptions o = quick_options(Backend::Cpu, Kernel::Wavefront, {});
+  o.max_paths_per_pass = 64 * 36 * 5;  // passes of 5, 5 and 2 samples
+  o.first_sample = 0;
+  const RenderResult one = render(quick(), o);
+  o.devices = {0, 1};
+  const RenderResult split = render(quick(), o);
+  expect_same_image(one, split, false, "three passes");
+  uint64_t paths = 0;
+  for (const DeviceShare& s : split.shares) paths += s.paths;
+  EXPECT_EQ(paths, 64u * 36 * 12);
+
+  o.first_sample = 4;
+  o.sample_count = 5;
+  o.devices = {};
+  const RenderResult part = render(quick(), o);
+  o.devices = {0, 1, 2};
+  expect_same_image(part, render(quick(), o), false, "samples 4 to 8");
+}
+
 TEST(Split, DeviceListsAreParsedAndChecked) {
   using app::parse_devices;
   EXPECT_EQ(parse_devices("all", Backend::Cuda, 2), (std::vector<int>{0, 1}));
@@ -236,16 +296,19 @@ TEST(Split, OneGpuTwiceRendersTheOneGpuImage) {
   for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
     const RenderResult one = render(quick(), quick_options(Backend::Cuda, k, {0}));
     const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 0}));
-    // Each worker keeps its chunks' sums on the device: the same samples, summed in
-    // other groups.
+    // Each worker keeps its chunks' sums (the wavefront: those of the paths it took)
+    // on the device: the same samples, summed in other groups.
     expect_same_image(one, split, false, kernel_name(k));
     ASSERT_EQ(split.shares.size(), 2u);
-    EXPECT_EQ(split.shares[0].samples + split.shares[1].samples, 12);
+    EXPECT_EQ(split.shares[0].paths + split.shares[1].paths, one.paths);
+    if (!is_wavefront(k)) {
+      EXPECT_EQ(split.shares[0].samples + split.shares[1].samples, 12);
+    }
   }
 }
 
 // Two GPUs where the machine has them: the split over both is the one-GPU image,
-// and both take part.
+// and (chunks) both take part.
 TEST(Split, TwoGpusRenderTheOneGpuImage) {
   WT_REQUIRE_CUDA();
   if (cuda::device_count() < 2) GTEST_SKIP() << "one CUDA device: the two-GPU split needs two";
@@ -254,8 +317,13 @@ TEST(Split, TwoGpusRenderTheOneGpuImage) {
     const RenderResult split = render(quick(), quick_options(Backend::Cuda, k, {0, 1}));
     expect_same_image(one, split, false, kernel_name(k));
     ASSERT_EQ(split.shares.size(), 2u);
-    EXPECT_GT(split.shares[0].chunks, 0);
-    EXPECT_GT(split.shares[1].chunks, 0);
+    EXPECT_EQ(split.shares[0].paths + split.shares[1].paths, one.paths);
+    if (!is_wavefront(k)) {
+      // (The wavefront's devices take blocks of paths as they ask: both do in
+      // practice, neither is bound to.)
+      EXPECT_GT(split.shares[0].chunks, 0);
+      EXPECT_GT(split.shares[1].chunks, 0);
+    }
   }
 }
 

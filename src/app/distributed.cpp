@@ -159,6 +159,7 @@ void combine_results(const Cluster& cluster, JobOutcome& out) {
       one.name = r.device;
       one.samples = static_cast<int32_t>(r.paths / (static_cast<uint64_t>(out.params.width) * out.params.height));
       one.chunks = one.samples > 0 ? 1 : 0;
+      one.paths = r.paths;
       one.seconds = r.seconds;
       one.rays = r.rays;
       one.shadow_rays = r.shadow_rays;

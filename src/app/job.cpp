@@ -373,9 +373,12 @@ void print_outcome(const Job& job, const JobOutcome& o) {
     std::fprintf(stderr, "  %d ranks: %.3f s wall clock from every rank's start to the summed film\n", o.ranks,
                  o.wall_seconds);
   }
+  const double pixels = static_cast<double>(o.params.width) * o.params.height;
   for (const DeviceShare& s : r.shares) {
-    std::fprintf(stderr, "  %s (%s): %d spp in %d chunks, %.3f s, %.1f M rays/s\n", s.device.c_str(), s.name.c_str(),
-                 s.samples, s.chunks, s.seconds, s.seconds > 0 ? s.rays / s.seconds / 1e6 : 0.0);
+    // Chunks of samples, or (a wavefront's devices sharing the paths) blocks of paths.
+    std::fprintf(stderr, "  %s (%s): %.1f spp in %d %s, %.3f s, %.1f M rays/s\n", s.device.c_str(), s.name.c_str(),
+                 pixels > 0 ? s.paths / pixels : 0.0, s.chunks, s.samples > 0 ? "chunks" : "blocks of paths",
+                 s.seconds, s.seconds > 0 ? s.rays / s.seconds / 1e6 : 0.0);
   }
 }
 

@@ -49,7 +49,7 @@ nlohmann::json geometry_json(const Scene::Summary& g) {
 
 nlohmann::json share_json(const DeviceShare& s) {
   return {{"device", s.device}, {"name", s.name},         {"samples", s.samples},        {"chunks", s.chunks},
-          {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}};
+          {"paths", s.paths},     {"seconds", s.seconds}, {"rays", s.rays}, {"shadow_rays", s.shadow_rays}};
 }
 
 DeviceShare share_of(const nlohmann::json& j) {
@@ -58,6 +58,7 @@ DeviceShare share_of(const nlohmann::json& j) {
   s.name = j.value("name", "");
   s.samples = j.value("samples", 0);
   s.chunks = j.value("chunks", 0);
+  s.paths = j.value("paths", uint64_t(0));
   s.seconds = j.value("seconds", 0.0);
   s.rays = j.value("rays", uint64_t(0));
   s.shadow_rays = j.value("shadow_rays", uint64_t(0));

@@ -3,8 +3,10 @@
 // stand on it without depending on the dispatcher that calls them.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,52 @@ using FilmReader = std::function<std::vector<float>()>;
 // Called after each pass of samples with the samples of every pixel the film now
 // sums (from sample 0); returning false stops the render there.
 using PassFn = std::function<bool(int32_t samples_done, const FilmReader& film)>;
+
+// The paths of one render that several devices' wavefronts share (render/split.hpp):
+// each pass's paths [0, total) handed out in blocks, each path once, as the devices
+// ask; a device renders the blocks it took and nothing else, so the devices' films
+// add up to the whole render however the blocks fell. Thread-safe.
+class PathFeed {
+ public:
+  // `devices` share it: a block is at most a 1/(8 x devices) share of a pass, so
+  // that each device gets several even of a small render.
+  explicit PathFeed(size_t devices) : devices_(devices == 0 ? 1 : devices) {}
+
+  struct Block {
+    uint32_t first = 0, end = 0;  // paths [first, end) of the pass; empty: none left
+    bool empty() const { return first == end; }
+  };
+  // The next block of pass `pass` (of `total` paths), of at most `want` paths; empty
+  // once stopped.
+  Block take(size_t pass, uint32_t total, uint32_t want) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (stopped_) return Block{total, total};
+    if (next_.size() <= pass) next_.resize(pass + 1, 0);
+    const uint64_t share = std::max<uint64_t>(1, total / (8 * devices_));
+    const uint64_t first = std::min<uint64_t>(next_[pass], total);
+    const uint64_t end = std::min<uint64_t>(total, first + std::min<uint64_t>(std::max<uint32_t>(want, 1), share));
+    next_[pass] = end;
+    return Block{static_cast<uint32_t>(first), static_cast<uint32_t>(end)};
+  }
+  // Paths handed out so far, over every pass.
+  uint64_t given() {
+    std::lock_guard<std::mutex> lock(m_);
+    uint64_t n = 0;
+    for (uint64_t p : next_) n += p;
+    return n;
+  }
+  // Hands out nothing more (a device failed: the others end after their blocks).
+  void stop() {
+    std::lock_guard<std::mutex> lock(m_);
+    stopped_ = true;
+  }
+
+ private:
+  const size_t devices_;
+  bool stopped_ = false;
+  std::mutex m_;
+  std::vector<uint64_t> next_;  // per pass, the first path not yet handed out
+};
 
 // Within a pass a path is a 32-bit index (pixel + pixels x sample within the pass):
 // no pass holds more paths than this, so any number of paths can be rendered.
@@ -67,14 +115,19 @@ struct RenderOptions {
   // result's rgb is empty. Null: the render's own film. CUDA kernels only; no
   // warm-ups, no initial film and no after_pass with it.
   float* device_film = nullptr;
+  // Paths shared with other devices (wavefront kernels): this render traces only the
+  // blocks it takes from the feed, of each pass of its samples, and its result's
+  // paths counts them. Not with warm-ups (which render without it) or after_pass.
+  PathFeed* path_feed = nullptr;
 };
 
 // What one device did in a render split over several (render/split.hpp).
 struct DeviceShare {
   std::string device;  // "cuda:1", "cpu:0"
   std::string name;    // what the backend calls it ("NVIDIA H200", "CPU (8 threads)")
-  int32_t samples = 0;  // samples per pixel it rendered
-  int32_t chunks = 0;
+  int32_t samples = 0;  // samples per pixel it rendered (0 where it took paths from a feed)
+  int32_t chunks = 0;   // chunks of samples, or blocks of paths, it took
+  uint64_t paths = 0;   // the paths it traced
   double seconds = 0;   // its renders' own time
   uint64_t rays = 0, shadow_rays = 0;
 };
@@ -103,6 +156,7 @@ struct RenderResult {
   std::vector<uint64_t> live_per_bounce;  // wavefront: paths alive entering each bounce
   // wavefront: the bounces (wave steps) with hits, and those whose hits were sorted
   uint64_t bounces_shaded = 0, bounces_sorted = 0;
+  uint64_t blocks = 0;  // wavefront with a path feed: the blocks of paths it took
   std::vector<DeviceShare> shares;  // a render split over several devices: each one's part
 };
 

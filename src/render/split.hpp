@@ -3,12 +3,17 @@
 // device), handed to the devices as they free up, so that a faster or less busy
 // device takes more of them. Each device keeps its chunks' sums and the devices'
 // sums are added in device order; where after_pass must see the film after every
-// chunk, the chunks are folded into the film in their order instead. The
-// counter-based random numbers make a path's value independent of where it runs, so
-// the image is the one-device image up to the order of float additions.
+// chunk, the chunks are folded into the film in their order instead. The wavefront
+// kernels, where no after_pass watches, share the render's paths instead: each
+// device renders all the samples but traces only the blocks of paths it takes from
+// one PathFeed, so that its wave refills across blocks and drains once, at the end,
+// rather than once a chunk. The counter-based random numbers make a path's value
+// independent of where it runs, so the image is the one-device image up to the
+// order of float additions.
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -131,6 +136,11 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   // device summed depends on timing, so the image then equals the chunk-order one
   // within float rounding rather than to the bit.
   const bool keep = !options.after_pass;
+  // The wavefront's devices share the paths of one render of every sample.
+  const bool fed = keep && is_wavefront(options.kernel);
+  PathFeed feed(devices);
+  // A fed device's rays so far, for progress lines.
+  std::vector<std::atomic<uint64_t>> fed_rays(devices);
   std::vector<std::vector<float>> kept(devices);
   bool stop = false;
   std::exception_ptr error;
@@ -161,11 +171,34 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         }
         ready_cv.wait(lock, [&] { return ready == devices || stop; });
       }
+      if (fed) {
+        chunk.first_sample = options.first_sample;
+        chunk.sample_count = options.sample_count;
+        chunk.path_feed = &feed;
+        if (options.progress) chunk.progress = [&, d](double, uint64_t rays, double) { fed_rays[d] = rays; };
+        RenderResult r = device_keeps ? renderer.render_kept(chunk) : render_chunk(chunk);
+        if (!device_keeps) {
+          if (r.rgb.size() != floats) {
+            throw DeviceError("its paths came back with " + std::to_string(r.rgb.size()) + " film values, not " +
+                              std::to_string(floats));
+          }
+          kept[d] = std::move(r.rgb);
+        }
+        std::lock_guard<std::mutex> lock(m);
+        DeviceShare& share = out.shares[d];
+        share.paths = r.paths;
+        share.chunks = static_cast<int32_t>(std::min<uint64_t>(INT32_MAX, r.blocks));
+        share.seconds = r.seconds;
+        share.rays = r.rays;
+        share.shadow_rays = r.shadow_rays;
+        share.name = r.device;
+        out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
+      }
       for (;;) {
         size_t c;
         {
           std::lock_guard<std::mutex> lock(m);
-          if (stop || next >= chunks.size()) break;
+          if (fed || stop || next >= chunks.size()) break;
           c = next++;
         }
         chunk.first_sample = chunks[c].first;
@@ -179,6 +212,7 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         std::lock_guard<std::mutex> lock(m);
         DeviceShare& share = out.shares[d];
         share.samples += chunks[c].count;
+        share.paths += static_cast<uint64_t>(chunks[c].count) * rp.width * rp.height;
         share.chunks += 1;
         share.seconds += r.seconds;
         share.rays += r.rays;
@@ -204,6 +238,7 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         failed_device = labels[d];
       }
       stop = true;
+      feed.stop();
       ready_cv.notify_all();
     }
     std::lock_guard<std::mutex> lock(m);
@@ -215,6 +250,21 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   for (size_t d = 0; d < devices; ++d) threads.emplace_back(work, d);
   // This thread folds the finished chunks into the film in their order while the
   // devices render the next ones; after_pass may stop the render after any chunk.
+  if (fed && options.progress) {
+    // Fed devices fold nothing until the end: progress is the paths handed out.
+    const double all_paths =
+        static_cast<double>(rp.width) * rp.height * (options.sample_count > 0 ? options.sample_count : rp.spp - options.first_sample);
+    std::unique_lock<std::mutex> lock(m);
+    while (!chunk_cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop || working == 0; })) {
+      if (ready < devices) continue;
+      lock.unlock();
+      uint64_t rays = 0;
+      for (const std::atomic<uint64_t>& r : fed_rays) rays += r;
+      options.progress(std::min(1.0, static_cast<double>(feed.given()) / all_paths), rays,
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      lock.lock();
+    }
+  }
   {
     std::unique_lock<std::mutex> lock(m);
     for (;;) {
@@ -257,6 +307,11 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
     for (; d < devices; ++d) split_detail::add_in_parallel(out.rgb, kept[d]);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (fed && !error) {
+    // Every path was traced (a device that fails throws above): the whole render.
+    folded = chunks.size();
+    out.samples = chunks.empty() ? options.first_sample : chunks.back().first + chunks.back().count;
+  }
   out.interrupted = folded < chunks.size();
   for (const DeviceShare& s : out.shares) {
     out.rays += s.rays;

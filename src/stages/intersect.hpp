@@ -101,4 +101,13 @@ struct AdvanceCountersItem {
   }
 };
 
+// Where the wave's next new path starts: `first`, a block of paths taken from a
+// PathFeed (render_types.hpp) once the block before it is used up. One thread.
+struct SetNextPathItem {
+  WaveCounters* counters;
+  uint32_t first;
+
+  WT_HD void operator()(uint32_t) const { counters->next_path = first; }
+};
+
 }  // namespace wt

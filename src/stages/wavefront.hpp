@@ -73,7 +73,10 @@ size_t wavefront_bytes(size_t capacity) {
 }
 
 // Renders with a wave of `capacity` slots, pass after pass of samples (each pass's
-// paths are numbered from 0 in 32 bits); the result holds pixel sums.
+// paths are numbered from 0 in 32 bits); the result holds pixel sums. With a path
+// feed (options.path_feed), of each pass only the blocks of paths it takes from the
+// feed: it takes the next block while a bounce may still use up the one it has, so
+// the wave refills across blocks and drains once a pass, when the feed is empty.
 template <class Exec>
 RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, const RenderOptions& options,
                               int64_t capacity) {
@@ -83,7 +86,9 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
   // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
   // ends with the wave draining, which a full wave's regeneration otherwise hides.
-  const std::vector<SamplePass> passes = plan_passes(options, 1, 4 * static_cast<uint64_t>(capacity));
+  // (With a feed every device must plan the same passes: none asked for, none by capacity.)
+  const std::vector<SamplePass> passes =
+      plan_passes(options, 1, options.path_feed ? 0 : 4 * static_cast<uint64_t>(capacity));
   const uint64_t all_paths = pixels * static_cast<uint64_t>(passes.empty() ? 0 : passes.back().first +
                                                                                    passes.back().count - passes.front().first);
   const uint32_t slots = static_cast<uint32_t>(capacity);
@@ -104,25 +109,62 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
       ex.zero(film, film_floats * sizeof(float));
     }
     std::vector<uint64_t> live_per_bounce;
-    uint64_t rays = 0, shadow_rays = 0, paths_done = 0, bounces_shaded = 0, bounces_sorted = 0;
+    uint64_t rays = 0, shadow_rays = 0, paths_done = 0, bounces_shaded = 0, bounces_sorted = 0, blocks = 0;
     out.samples = options.first_sample;
     out.interrupted = false;
+    PathFeed* const feed = last ? options.path_feed : nullptr;
     ex.start_timer();
-    for (const SamplePass& pass : passes) {
+    for (size_t pass_index = 0; pass_index < passes.size(); ++pass_index) {
+      const SamplePass& pass = passes[pass_index];
       const uint32_t total = static_cast<uint32_t>(pixels * static_cast<uint64_t>(pass.count));
       const uint32_t first = static_cast<uint32_t>(pass.first);
       ex.zero(w.counters, sizeof(WaveCounters));
+      // The wave generates paths up to `limit`: the pass's end, or that of the feed's
+      // block it works on; `pending` is the block after it, `fed_out` when none is left.
+      uint32_t limit = total;
+      PathFeed::Block pending;
+      bool fed_out = feed == nullptr;
+      uint64_t taken = feed ? 0 : total;
+      if (feed) {
+        const PathFeed::Block b = feed->take(pass_index, total, slots);
+        if (b.empty()) continue;
+        if (b.first != 0) ex.launch(stage::kIntersect, 1, SetNextPathItem{w.counters, b.first});
+        limit = b.end;
+        taken += b.end - b.first;
+        ++blocks;
+      }
       for (int cur = 0;; cur = 1 - cur) {
         with_kinds<false>(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
-                    IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, total, first,
+                    IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, limit, first,
                                            slots, film});
         });
-        ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, total, slots});
+        ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, limit, slots});
         ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,
                   w.temp_bytes);
         const WaveCounters c = ex.read(stage::kReadback, w.counters);
         live_per_bounce.push_back(c.queued[cur]);
+        uint32_t next_path = c.next_path;
+        if (!fed_out && pending.empty() && static_cast<uint64_t>(next_path) + slots > limit) {
+          // The next bounce may use the block up: take the next (one that follows it
+          // extends it).
+          const PathFeed::Block b = feed->take(pass_index, total, slots);
+          taken += b.end - b.first;
+          blocks += b.empty() ? 0 : 1;
+          if (b.empty()) {
+            fed_out = true;
+          } else if (b.first == limit) {
+            limit = b.end;
+          } else {
+            pending = b;
+          }
+        }
+        if (!pending.empty() && next_path >= limit) {
+          ex.launch(stage::kIntersect, 1, SetNextPathItem{w.counters, pending.first});
+          next_path = pending.first;
+          limit = pending.end;
+          pending = PathFeed::Block{};
+        }
 
         const uint32_t* list = w.selected;
         if (c.hits > 0) ++bounces_shaded;
@@ -143,13 +185,13 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
           options.progress(static_cast<double>(paths_done + c.next_path - c.queued[cur]) / all_paths, rays + c.rays,
                            ex.elapsed_host());
         }
-        if (c.hits == 0 && c.next_path >= total) {
+        if (c.hits == 0 && next_path >= limit) {
           rays += c.rays;
           shadow_rays += c.shadow_rays;
           break;
         }
       }
-      paths_done += total;
+      paths_done += taken;
       out.samples = pass.first + pass.count;
       if (last && options.after_pass &&
           !options.after_pass(out.samples, [&] { return ex.download(film, film_floats); })) {
@@ -162,6 +204,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
     out.shadow_rays = shadow_rays;
     out.bounces_shaded = bounces_shaded;
     out.bounces_sorted = bounces_sorted;
+    out.blocks = blocks;
     out.paths = paths_done;
     const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
     out.stages.clear();
