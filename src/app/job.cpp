@@ -205,6 +205,7 @@ std::string render_signature(const JobOutcome& o) {
 JobOutcome run_job(const Job& job) { return run_job(job, Cluster()); }
 
 JobOutcome run_job(const Job& job, const Cluster& cluster) {
+  const auto job_start = std::chrono::steady_clock::now();
   JobOutcome out;
   const bool distributed = cluster.distributed();
   // The CUDA context starts while the scene loads: that of the first device the job
@@ -348,8 +349,12 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     if (distributed) take_mean(out.result);
     // Both files are written in full before either takes its name: a disk that fills
     // up during the second leaves neither.
+    const auto write_start = std::chrono::steady_clock::now();
     StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
                                    job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
+    const auto written = std::chrono::steady_clock::now();
+    out.write_seconds = std::chrono::duration<double>(written - write_start).count();
+    out.job_seconds = std::chrono::duration<double>(written - job_start).count();
     StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
     image.commit();
     stats.commit();

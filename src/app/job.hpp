@@ -60,6 +60,9 @@ struct JobOutcome {
   // rank had its scene to the summed film (result.seconds: the slowest rank's render).
   int ranks = 1;
   double wall_seconds = 0;
+  // Wall clock of the whole job up to its image written, from the start of run_job
+  // (scene, device set-up, render, image), and of encoding and writing the image.
+  double job_seconds = 0, write_seconds = 0;
 };
 
 // Runs a job; never throws. Writes the image (and stats) only when the render and

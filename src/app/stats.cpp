@@ -113,6 +113,8 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
     j["wall_seconds"] = o.wall_seconds;
   }
   j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
+  j["job_seconds"] = o.job_seconds;
+  j["write_seconds"] = o.write_seconds;
   add_measurements(j, r, r.seconds, o.load_times);
   j["geometry"] = geometry_json(o.geometry);
   return j;
