@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 
 #include "app/batch.hpp"
 #include "app/cli.hpp"
+#include "app/process.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -322,6 +324,31 @@ done)sh");
   EXPECT_NE(seen[2].first, seen[3].first);
   EXPECT_EQ(seen[3].first, seen[4].first);
   EXPECT_NE(seen[4].first, seen[5].first);
+}
+
+// A worker killed while it waits for its next question (from outside: the kernel's
+// out-of-memory killer, a user) is replaced before the question is sent, so the job
+// is asked of a live worker rather than failed.
+TEST_F(BatchProcessTest, AWorkerKilledWhileItWaitsIsReplacedBeforeTheNextQuestion) {
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+while read -r line; do echo "$$ $line" >&3; done)sh");
+  WorkerProcess worker(exe);
+  ChildEnd end;
+  const std::optional<std::string> first = worker.ask("a", end);
+  ASSERT_TRUE(first.has_value());
+  const pid_t pid = worker.pid();
+  EXPECT_EQ(*first, std::to_string(pid) + " a");
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  siginfo_t info{};
+  ASSERT_EQ(::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOWAIT), 0);  // dead, not yet reaped
+  const std::optional<std::string> second = worker.ask("b", end);
+  ASSERT_TRUE(second.has_value()) << "the question went to the dead worker";
+  EXPECT_NE(worker.pid(), pid);
+  EXPECT_EQ(*second, std::to_string(worker.pid()) + " b");
+  const ChildEnd stopped = worker.stop();
+  EXPECT_TRUE(stopped.exited);
+  EXPECT_EQ(stopped.exit_code, 0);
+  EXPECT_EQ(worker.pid(), 0);
 }
 
 // SIGTERM sent to the batch reaches the worker rendering a job; the batch stops.

@@ -283,19 +283,17 @@ WorkerProcess::WorkerProcess(std::string executable) : executable_(std::move(exe
 WorkerProcess::~WorkerProcess() { stop(); }
 
 void WorkerProcess::start() {
-  const std::array<int, 2> to = high_pipe();
-  std::array<int, 2> from{};
+  const int slot = take_slot();
+  std::array<int, 2> to{-1, -1}, from{-1, -1};
   try {
+    to = high_pipe();
     from = high_pipe();
-  } catch (...) {
-    ::close(to[0]);
-    ::close(to[1]);
-    throw;
-  }
-  try {
     pid_ = spawn(executable_, {"worker"}, {{to[0], STDIN_FILENO}, {from[1], 3}});
   } catch (...) {
-    for (int fd : {to[0], to[1], from[0], from[1]}) ::close(fd);
+    for (int fd : {to[0], to[1], from[0], from[1]}) {
+      if (fd >= 0) ::close(fd);
+    }
+    free_slot(slot);
     throw;
   }
   ::close(to[0]);
@@ -303,13 +301,30 @@ void WorkerProcess::start() {
   to_ = to[1];
   from_ = from[0];
   pending_.clear();
-  slot_ = take_slot();
+  slot_ = slot;
   set_child(slot_, pid_);
 }
 
 std::optional<std::string> WorkerProcess::ask(const std::string& question, ChildEnd& end) {
+  // A worker that died while it waited (killed from outside) is replaced: the
+  // question has not reached it. So is one gone before it read the question.
+  int status = 0;
+  if (pid_ != 0 && ::waitpid(pid_, &status, WNOHANG) == pid_) {
+    ::close(to_);
+    ::close(from_);
+    set_child(slot_, 0);
+    free_slot(slot_);
+    pid_ = 0;
+    slot_ = to_ = from_ = -1;
+  }
   if (pid_ == 0) start();
-  if (write_or_gone(to_, question + "\n")) {
+  bool sent = write_or_gone(to_, question + "\n");
+  if (!sent) {
+    stop();
+    start();
+    sent = write_or_gone(to_, question + "\n");
+  }
+  if (sent) {
     char buf[4096];
     for (;;) {
       const size_t newline = pending_.find('\n');

@@ -56,10 +56,13 @@ class WorkerProcess {
 
   // Sends `question` (one line, without its newline) and waits for the answer. No
   // answer: the process ended first (how: in `end`), and the next question starts a
-  // new one. Throws std::runtime_error if it cannot be started.
+  // new one. A process found ended before it got the question is replaced at once.
+  // Throws std::runtime_error if it cannot be started.
   std::optional<std::string> ask(const std::string& question, ChildEnd& end);
   // Closes its input, which ends it, and waits for it to exit; its end.
   ChildEnd stop();
+  // Its process id while it runs, else 0.
+  pid_t pid() const { return pid_; }
 
  private:
   void start();
