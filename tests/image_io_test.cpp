@@ -7,6 +7,7 @@
 #include <stb/stb_image.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include "exr_support.hpp"
 #include "image/image_io.hpp"
 #include "test_support.hpp"
+#include "wavetrace/film.hpp"
 
 namespace wt {
 namespace {
@@ -52,6 +54,19 @@ TEST(PngRoundTrip, SrgbValuesLandAtTheirPixelsAndChannels) {
       188, 188, 188,  255, 0, 0,     0, 0, 255,
   };
   EXPECT_EQ(round_trip(rgb, 3, 2, Encoding::Srgb), expected);
+}
+
+// An image large enough that its transfer curve is applied in parts on several
+// threads: every value lands where it belongs, as the curve gives it on one.
+TEST(PngRoundTrip, ALargeImageConvertedInPartsHoldsEveryValue) {
+  const int w = 1021, h = 517;  // 1.58 M values: several parts, the last one short
+  std::vector<float> rgb(static_cast<size_t>(w) * h * 3);
+  for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = static_cast<float>((i * 2654435761u) % 1000) / 900.0f;
+  const std::vector<unsigned char> back = round_trip(rgb, w, h, Encoding::Srgb);
+  ASSERT_EQ(back.size(), rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    ASSERT_EQ(back[i], static_cast<unsigned char>(std::lround(encode_srgb(rgb[i]) * 255.0f))) << i;
+  }
 }
 
 TEST(PngRoundTrip, Gamma2IsTheSquareRoot) {
