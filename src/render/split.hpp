@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "cpu/parallel.hpp"
 #include "cuda/device.hpp"
 #include "render/passes.hpp"
 #include "render/render_types.hpp"
@@ -66,19 +67,22 @@ using MakeChunkRenderer = std::function<DeviceRenderer(size_t device)>;
 
 namespace split_detail {
 
-// sums += more, element by element, over the host's cores.
+// sums += more, element by element, over the host's cores (at most 16).
 inline void add_in_parallel(std::vector<float>& sums, const std::vector<float>& more) {
   if (more.empty()) return;
-  const size_t parts = std::max(1u, std::min(16u, std::thread::hardware_concurrency()));
-  const size_t each = (more.size() + parts - 1) / parts;
-  std::vector<std::thread> adders;
-  for (size_t p = 0; p < parts; ++p) {
-    adders.emplace_back([&, p] {
-      const size_t end = std::min(more.size(), (p + 1) * each);
-      for (size_t i = p * each; i < end; ++i) sums[i] += more[i];
-    });
+  const int parts = std::min(16, cpu::thread_count(0));
+  const int64_t n = static_cast<int64_t>(more.size());
+  cpu::parallel_for(n, (n + parts - 1) / parts, parts, [&](int64_t begin, int64_t end, int) {
+    for (int64_t i = begin; i < end; ++i) sums[i] += more[i];
+  });
+}
+
+// Throws DeviceError unless `what` (a device's film) came back with `floats` values.
+inline void require_film(size_t values, size_t floats, const char* what) {
+  if (values != floats) {
+    throw DeviceError(std::string(what) + " came back with " + std::to_string(values) + " film values, not " +
+                      std::to_string(floats));
   }
-  for (std::thread& t : adders) t.join();
 }
 
 // Adds `more` into `sums` (taking it where `sums` is still empty).
@@ -171,64 +175,54 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         }
         ready_cv.wait(lock, [&] { return ready == devices || stop; });
       }
+      // Counts one of this device's renders (`pieces` chunks or blocks) into its share; under m.
+      auto count = [&](const RenderResult& r, int32_t samples, uint64_t paths, uint64_t pieces) {
+        DeviceShare& share = out.shares[d];
+        share.samples += samples;
+        share.paths += paths;
+        share.chunks += static_cast<int32_t>(std::min<uint64_t>(INT32_MAX, pieces));
+        share.seconds += r.seconds;
+        share.rays += r.rays;
+        share.shadow_rays += r.shadow_rays;
+        if (share.name.empty()) share.name = r.device;
+        out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
+      };
       if (fed) {
+        // One render of every sample, of the paths this device takes from the feed.
         chunk.first_sample = options.first_sample;
         chunk.sample_count = options.sample_count;
         chunk.path_feed = &feed;
         if (options.progress) chunk.progress = [&, d](double, uint64_t rays, double) { fed_rays[d] = rays; };
         RenderResult r = device_keeps ? renderer.render_kept(chunk) : render_chunk(chunk);
         if (!device_keeps) {
-          if (r.rgb.size() != floats) {
-            throw DeviceError("its paths came back with " + std::to_string(r.rgb.size()) + " film values, not " +
-                              std::to_string(floats));
+          split_detail::require_film(r.rgb.size(), floats, "its paths");
+          split_detail::add_into(kept[d], std::move(r.rgb));
+        }
+        std::lock_guard<std::mutex> lock(m);
+        count(r, 0, r.paths, r.blocks);
+      } else {
+        for (;;) {
+          size_t c;
+          {
+            std::lock_guard<std::mutex> lock(m);
+            if (stop || next >= chunks.size()) break;
+            c = next++;
           }
-          kept[d] = std::move(r.rgb);
-        }
-        std::lock_guard<std::mutex> lock(m);
-        DeviceShare& share = out.shares[d];
-        share.paths = r.paths;
-        share.chunks = static_cast<int32_t>(std::min<uint64_t>(INT32_MAX, r.blocks));
-        share.seconds = r.seconds;
-        share.rays = r.rays;
-        share.shadow_rays = r.shadow_rays;
-        share.name = r.device;
-        out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
-      }
-      for (;;) {
-        size_t c;
-        {
+          chunk.first_sample = chunks[c].first;
+          chunk.sample_count = chunks[c].count;
+          RenderResult r = device_keeps ? renderer.render_kept(chunk) : render_chunk(chunk);
+          if (!device_keeps) split_detail::require_film(r.rgb.size(), floats, "a chunk");
+          if (keep && !device_keeps) split_detail::add_into(kept[d], std::move(r.rgb));
           std::lock_guard<std::mutex> lock(m);
-          if (fed || stop || next >= chunks.size()) break;
-          c = next++;
+          count(r, chunks[c].count, static_cast<uint64_t>(chunks[c].count) * rp.width * rp.height, 1);
+          if (!keep) waiting[c] = std::move(r.rgb);
+          finished[c] = 1;
+          chunk_cv.notify_all();
         }
-        chunk.first_sample = chunks[c].first;
-        chunk.sample_count = chunks[c].count;
-        RenderResult r = device_keeps ? renderer.render_kept(chunk) : render_chunk(chunk);
-        if (!device_keeps && r.rgb.size() != floats) {
-          throw DeviceError("a chunk came back with " + std::to_string(r.rgb.size()) + " film values, not " +
-                            std::to_string(floats));
-        }
-        if (keep && !device_keeps) split_detail::add_into(kept[d], std::move(r.rgb));
-        std::lock_guard<std::mutex> lock(m);
-        DeviceShare& share = out.shares[d];
-        share.samples += chunks[c].count;
-        share.paths += static_cast<uint64_t>(chunks[c].count) * rp.width * rp.height;
-        share.chunks += 1;
-        share.seconds += r.seconds;
-        share.rays += r.rays;
-        share.shadow_rays += r.shadow_rays;
-        if (share.name.empty()) share.name = r.device;
-        out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
-        if (!keep) waiting[c] = std::move(r.rgb);
-        finished[c] = 1;
-        chunk_cv.notify_all();
       }
       if (device_keeps) {
         std::vector<float> sums = renderer.collect();
-        if (sums.size() != floats && !sums.empty()) {
-          throw DeviceError("its sums came back with " + std::to_string(sums.size()) + " film values, not " +
-                            std::to_string(floats));
-        }
+        if (!sums.empty()) split_detail::require_film(sums.size(), floats, "its sums");
         split_detail::add_into(kept[d], std::move(sums));
       }
     } catch (...) {
@@ -252,8 +246,8 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   // devices render the next ones; after_pass may stop the render after any chunk.
   if (fed && options.progress) {
     // Fed devices fold nothing until the end: progress is the paths handed out.
-    const double all_paths =
-        static_cast<double>(rp.width) * rp.height * (options.sample_count > 0 ? options.sample_count : rp.spp - options.first_sample);
+    double all_paths = 0;
+    for (const SamplePass& c : chunks) all_paths += static_cast<double>(rp.width) * rp.height * c.count;
     std::unique_lock<std::mutex> lock(m);
     while (!chunk_cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop || working == 0; })) {
       if (ready < devices) continue;
