@@ -458,7 +458,8 @@ void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool
     const size_t index = given["index"].get<size_t>();
     JobOutcome o;
     try {
-      o = run(static_cast<size_t>(tag), index, lane_job(parse_render_arguments(given["args"].get<std::vector<std::string>>()), devices, quiet));
+      const Job job = parse_render_arguments(given["args"].get<std::vector<std::string>>());
+      o = run(static_cast<size_t>(tag), index, lane_job(job, devices, quiet));
     } catch (const std::exception& e) {
       o.exit_code = kExitFailure;
       o.message = std::string("rank ") + std::to_string(cluster.rank()) + " could not take the job: " + e.what();
@@ -476,7 +477,9 @@ int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, 
   const SignalForwarder signals;
   // A worker per lane (made before the lanes start, ended before the forwarder).
   std::vector<std::unique_ptr<WorkerProcess>> workers;
-  for (size_t l = 0; l < lanes.size(); ++l) workers.push_back(std::make_unique<WorkerProcess>(executable));
+  if (processes == JobProcesses::PerLane) {
+    for (size_t l = 0; l < lanes.size(); ++l) workers.push_back(std::make_unique<WorkerProcess>(executable));
+  }
   const JobRunner run = [&](size_t lane, size_t index, const Job& job) {
     return processes == JobProcesses::PerJob ? run_job_in_process(executable, index, job, signals)
                                              : run_job_in_worker(*workers.at(lane), index, job, signals);
@@ -507,7 +510,9 @@ int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, 
 int run_batch_worker(int answers) {
   FILE* out = ::fdopen(answers, "w");
   if (!out) {
-    std::fprintf(stderr, "wavetrace: worker: descriptor %d is not open for answers (the worker is started by wavetrace batch)\n", answers);
+    std::fprintf(stderr,
+                 "wavetrace: worker: descriptor %d is not open for answers (the worker is started by wavetrace batch)\n",
+                 answers);
     return kExitFailure;
   }
   for (std::string line; std::getline(std::cin, line);) {

@@ -309,14 +309,7 @@ std::optional<std::string> WorkerProcess::ask(const std::string& question, Child
   // A worker that died while it waited (killed from outside) is replaced: the
   // question has not reached it. So is one gone before it read the question.
   int status = 0;
-  if (pid_ != 0 && ::waitpid(pid_, &status, WNOHANG) == pid_) {
-    ::close(to_);
-    ::close(from_);
-    set_child(slot_, 0);
-    free_slot(slot_);
-    pid_ = 0;
-    slot_ = to_ = from_ = -1;
-  }
+  if (pid_ != 0 && ::waitpid(pid_, &status, WNOHANG) == pid_) release();
   if (pid_ == 0) start();
   bool sent = write_or_gone(to_, question + "\n");
   if (!sent) {
@@ -347,14 +340,23 @@ std::optional<std::string> WorkerProcess::ask(const std::string& question, Child
 
 ChildEnd WorkerProcess::stop() {
   if (pid_ == 0) return {};
+  // Its input closed, it exits; its answers, closed, cannot hold it up.
   ::close(to_);
   ::close(from_);
+  to_ = from_ = -1;
   const ChildEnd end = wait_for(pid_);
+  release();
+  return end;
+}
+
+void WorkerProcess::release() {
+  for (int fd : {to_, from_}) {
+    if (fd >= 0) ::close(fd);
+  }
   set_child(slot_, 0);
   free_slot(slot_);
   pid_ = 0;
   slot_ = to_ = from_ = -1;
-  return end;
 }
 
 }  // namespace wt::app

@@ -66,6 +66,8 @@ class WorkerProcess {
 
  private:
   void start();
+  // Forgets the process (its exit already waited for): its pipes and signal slot.
+  void release();
   std::string executable_;
   pid_t pid_ = 0;
   int slot_ = -1;
