@@ -6,6 +6,7 @@
 // passes, resumption, stopping and a failing device behave as on one device.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -186,9 +187,16 @@ TEST(Split, ADeviceThatKeepsItsSumsBringsThemBackOnce) {
   const RenderOptions o = quick_options(Backend::Cpu, Kernel::Megakernel, {});
   const RenderResult one = render(quick(), o);
   std::mutex m;
-  std::atomic<int> kept_chunks{0}, plain_chunks{0}, collects{0};
+  std::atomic<int> kept_chunks{0}, plain_chunks{0}, collects{0}, prepares{0};
+  // The sums a device brings back are its renderer's: destroying the renderer
+  // spoils them, so an image made after that would show it.
+  struct SpoiledWithTheRenderer {
+    std::shared_ptr<std::vector<float>> sums;
+    ~SpoiledWithTheRenderer() { std::fill(sums->begin(), sums->end(), std::nanf("")); }
+  };
   auto keeping = [&](size_t) -> DeviceRenderer {
     auto sums = std::make_shared<std::vector<float>>();
+    auto spoiled = std::make_shared<SpoiledWithTheRenderer>(SpoiledWithTheRenderer{sums});
     return {[&](const RenderOptions& chunk) {
               ++plain_chunks;
               return render_sums(quick(), chunk);
@@ -202,9 +210,13 @@ TEST(Split, ADeviceThatKeepsItsSumsBringsThemBackOnce) {
               r.rgb.clear();
               return r;
             },
-            [&, sums] {
+            [&, sums, spoiled] {
               ++collects;
-              return *sums;
+              return FilmSums{sums->data(), sums->size()};
+            },
+            [&, sums](const RenderOptions&) {
+              ++prepares;
+              EXPECT_TRUE(sums->empty()) << "prepared before any chunk";
             }};
   };
   RenderResult split = render_split(o, {"gpu:0", "gpu:1", "gpu:2"}, keeping);
@@ -213,17 +225,37 @@ TEST(Split, ADeviceThatKeepsItsSumsBringsThemBackOnce) {
   EXPECT_EQ(kept_chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * 3)));
   EXPECT_EQ(plain_chunks, 0);
   EXPECT_EQ(collects, 3);
+  EXPECT_EQ(prepares, 3);
 
   RenderOptions watched = o;
   int passes = 0;
   watched.after_pass = [&](int32_t, const FilmReader&) { return ++passes > 0; };
-  kept_chunks = plain_chunks = collects = 0;
+  kept_chunks = plain_chunks = collects = prepares = 0;
   RenderResult in_order = render_split(watched, {"gpu:0", "gpu:1"}, keeping);
   take_mean(in_order);
   expect_same_image(one, in_order, false, "chunk order");
   EXPECT_EQ(kept_chunks, 0);
   EXPECT_EQ(plain_chunks, std::min(12, std::max(kMinChunks, kChunksPerDevice * 2)));
   EXPECT_EQ(passes, plain_chunks);
+  EXPECT_EQ(prepares, 0);
+}
+
+// A pass watcher that fails (a checkpoint that cannot be written) fails the render
+// with its error once the devices have stopped; it neither hangs nor aborts.
+TEST(Split, AFailingPassWatcherFailsTheRender) {
+  RenderOptions o = quick_options(Backend::Cpu, Kernel::Megakernel, {0, 1});
+  int passes = 0;
+  o.after_pass = [&](int32_t, const FilmReader&) -> bool {
+    if (++passes == 2) throw std::runtime_error("checkpoint: disk full");
+    return true;
+  };
+  try {
+    render(quick(), o);
+    FAIL() << "the render went on";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "checkpoint: disk full");
+  }
+  EXPECT_EQ(passes, 2);
 }
 
 // A path feed hands out each path of each pass once, in blocks of at most what the

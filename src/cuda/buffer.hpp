@@ -63,4 +63,30 @@ class DeviceBuffer {
   size_t size_ = 0;
 };
 
+// Page-locked host memory, which the GPU copies to at full speed. Made before it is
+// needed: allocating it costs milliseconds.
+template <class T>
+class PinnedBuffer {
+ public:
+  PinnedBuffer(size_t n, const char* stage) : size_(n) {
+    if (n) WT_CUDA(cudaMallocHost(reinterpret_cast<void**>(&ptr_), n * sizeof(T)), stage);
+  }
+  ~PinnedBuffer() {
+    if (ptr_) cudaFreeHost(ptr_);  // as DeviceBuffer: errors surface at the next call
+  }
+  PinnedBuffer(const PinnedBuffer&) = delete;
+  PinnedBuffer& operator=(const PinnedBuffer&) = delete;
+
+  // Copies `device` (size() values) here and waits for it.
+  void download(const T* device, const char* stage) {
+    if (size_) WT_CUDA(cudaMemcpy(ptr_, device, size_ * sizeof(T), cudaMemcpyDeviceToHost), stage);
+  }
+  const T* get() const { return ptr_; }
+  size_t size() const { return size_; }
+
+ private:
+  T* ptr_ = nullptr;
+  size_t size_ = 0;
+};
+
 }  // namespace wt::cuda

@@ -126,24 +126,32 @@ class Uploaded {
     upload_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
-  // A chunk whose sums are added to this device's kept sums (made and cleared at the
-  // first), which collect() brings back once.
+  // The sums the chunks of render_kept add to, cleared, and the host memory collect()
+  // brings them back to: made before the render's clock starts (or at the first chunk).
+  void prepare_kept(const RenderOptions& options) {
+    if (kept_) return;
+    const RenderParams& rp = options.params;
+    const size_t floats = static_cast<size_t>(rp.width) * rp.height * 3;
+    kept_ = std::make_unique<DeviceBuffer<float>>(floats, "split");
+    kept_->zero("split");
+    kept_host_ = std::make_unique<PinnedBuffer<float>>(floats, "split");
+    WT_CUDA(cudaDeviceSynchronize(), "split");  // cleared before any stream adds to it
+  }
+
+  // A chunk whose sums are added to this device's kept sums, which collect() brings
+  // back once.
   RenderResult render_kept(const RenderOptions& options) {
-    if (!kept_) {
-      const RenderParams& rp = options.params;
-      kept_ = std::make_unique<DeviceBuffer<float>>(static_cast<size_t>(rp.width) * rp.height * 3, "split");
-      kept_->zero("split");
-      WT_CUDA(cudaDeviceSynchronize(), "split");  // cleared before any stream adds to it
-    }
+    prepare_kept(options);
     RenderOptions into = options;
     into.device_film = kept_->get();
     return render(into);
   }
 
-  std::vector<float> collect() const {
+  FilmSums collect() const {
     if (!kept_) return {};
     WT_CUDA(cudaDeviceSynchronize(), "split");  // every chunk's additions are in
-    return kept_->download("split");
+    kept_host_->download(kept_->get(), "split");
+    return FilmSums{kept_host_->get(), kept_host_->size()};
   }
 
   RenderResult render(const RenderOptions& options) const {
@@ -161,6 +169,7 @@ class Uploaded {
   int64_t wave_ = 0;
   std::unique_ptr<DeviceScene> ds_;
   std::unique_ptr<DeviceBuffer<float>> kept_;
+  std::unique_ptr<PinnedBuffer<float>> kept_host_;
   // The wavefront's setup (pinned counters, the wave's memory), kept from one of this
   // device's renders to the next.
   mutable WaveRenderer waves_;
@@ -182,7 +191,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
       auto uploaded = std::make_shared<Uploaded>(scene, options);
       return {[uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); },
               [uploaded](const RenderOptions& chunk) { return uploaded->render_kept(chunk); },
-              [uploaded] { return uploaded->collect(); }};
+              [uploaded] { return uploaded->collect(); },
+              [uploaded](const RenderOptions& chunk) { uploaded->prepare_kept(chunk); }};
     });
   }
   if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");

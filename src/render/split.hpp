@@ -19,6 +19,7 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -53,27 +54,40 @@ inline void require_cuda_devices(const std::vector<int>& devices, int present) {
 // upload the scene), then called on it with each chunk's options. `render` returns
 // the chunk's pixel sums (Radiance::SumOfSamples) and its counts. A device that can
 // keep sums of its own (a GPU, in its memory) also has `render_kept`, which adds the
-// chunk's sums to them and returns its counts alone, and `collect`, which brings
-// them back once at the end.
+// chunk's sums to them and returns its counts alone, `collect`, which brings them
+// back once at the end, and may have `prepare`, which sets up both the kept sums and
+// the host memory they come back to before the render's clock starts.
 using ChunkRenderer = std::function<RenderResult(const RenderOptions& chunk)>;
+// A device's sums on the host: `size` floats, owned by the device's renderer and
+// valid until it is destroyed.
+struct FilmSums {
+  const float* data = nullptr;
+  size_t size = 0;
+};
 struct DeviceRenderer {
-  DeviceRenderer(ChunkRenderer r, ChunkRenderer kept = {}, std::function<std::vector<float>()> c = {})
-      : render(std::move(r)), render_kept(std::move(kept)), collect(std::move(c)) {}
+  DeviceRenderer(ChunkRenderer r, ChunkRenderer kept = {}, std::function<FilmSums()> c = {},
+                 std::function<void(const RenderOptions&)> p = {})
+      : render(std::move(r)), render_kept(std::move(kept)), collect(std::move(c)), prepare(std::move(p)) {}
   ChunkRenderer render;
-  ChunkRenderer render_kept;                     // may be empty
-  std::function<std::vector<float>()> collect;  // with render_kept
+  ChunkRenderer render_kept;                        // may be empty
+  std::function<FilmSums()> collect;               // with render_kept
+  std::function<void(const RenderOptions&)> prepare;  // with render_kept; may be empty
 };
 using MakeChunkRenderer = std::function<DeviceRenderer(size_t device)>;
 
 namespace split_detail {
 
-// sums += more, element by element, over the host's cores (at most 16).
-inline void add_in_parallel(std::vector<float>& sums, const std::vector<float>& more) {
-  if (more.empty()) return;
+// film += each device's sums, in device order for every value (so that the result
+// does not depend on the threads), over the host's cores (at most 16), each its own
+// range of values. Devices without sums are skipped.
+inline void add_in_order(std::vector<float>& film, const std::vector<FilmSums>& sums) {
   const int parts = std::min(16, cpu::thread_count(0));
-  const int64_t n = static_cast<int64_t>(more.size());
+  const int64_t n = static_cast<int64_t>(film.size());
   cpu::parallel_for(n, (n + parts - 1) / parts, parts, [&](int64_t begin, int64_t end, int) {
-    for (int64_t i = begin; i < end; ++i) sums[i] += more[i];
+    for (const FilmSums& s : sums) {
+      if (s.data == nullptr) continue;
+      for (int64_t i = begin; i < end; ++i) film[i] += s.data[i];
+    }
   });
 }
 
@@ -111,9 +125,11 @@ inline void add_into(std::vector<float>& sums, std::vector<float>&& more) {
 
 // Renders `options` over the devices `labels` names (one worker thread each). The
 // result's shares say what each device did; its seconds run from when every device
-// has its scene (and its warm-up renders) to the last chunk. A device that fails
-// stops the others after their current chunk, and the render throws its error,
-// named after the device; no partial result is returned.
+// has its scene, its warm-up renders and the memory its sums need, to the film that
+// adds every device's sums (as one device's seconds end with its sums in its memory,
+// before the film comes back; freeing each device's memory comes after). A device
+// that fails stops the others after their current chunk, and the render throws its
+// error, named after the device; no partial result is returned.
 inline RenderResult render_split(const RenderOptions& options, const std::vector<std::string>& labels,
                                  const MakeChunkRenderer& make) {
   const size_t devices = labels.size();
@@ -145,15 +161,19 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   PathFeed feed(devices);
   // A fed device's rays so far, for progress lines.
   std::vector<std::atomic<uint64_t>> fed_rays(devices);
-  std::vector<std::vector<float>> kept(devices);
-  bool stop = false;
+  std::vector<std::vector<float>> kept(devices);  // sums a device returned to the host
+  std::vector<FilmSums> sums_of(devices);          // every device's sums, at the end
+  bool stop = false, released = false;
+  std::condition_variable release_cv;
   std::exception_ptr error;
   std::string failed_device;
   std::chrono::steady_clock::time_point start;
 
   auto work = [&](size_t d) {
+    std::optional<DeviceRenderer> made;
     try {
-      DeviceRenderer renderer = make(d);
+      made.emplace(make(d));
+      DeviceRenderer& renderer = *made;
       const ChunkRenderer& render_chunk = renderer.render;
       const bool device_keeps = keep && renderer.render_kept && renderer.collect;
       RenderOptions chunk = options;
@@ -167,6 +187,7 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         render_chunk(chunk);  // the warm-ups, untimed, before the start
       }
       chunk.warmup = 0;
+      if (device_keeps && renderer.prepare) renderer.prepare(chunk);
       {
         std::unique_lock<std::mutex> lock(m);
         if (++ready == devices) {
@@ -221,9 +242,13 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
         }
       }
       if (device_keeps) {
-        std::vector<float> sums = renderer.collect();
-        if (!sums.empty()) split_detail::require_film(sums.size(), floats, "its sums");
-        split_detail::add_into(kept[d], std::move(sums));
+        const FilmSums sums = renderer.collect();  // none (size 0) where it took no chunk
+        if (sums.size != 0) {
+          split_detail::require_film(sums.size, floats, "its sums");
+          sums_of[d] = sums;
+        }
+      } else if (!kept[d].empty()) {
+        sums_of[d] = FilmSums{kept[d].data(), kept[d].size()};
       }
     } catch (...) {
       std::lock_guard<std::mutex> lock(m);
@@ -235,72 +260,106 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
       feed.stop();
       ready_cv.notify_all();
     }
-    std::lock_guard<std::mutex> lock(m);
+    std::unique_lock<std::mutex> lock(m);
     --working;
     chunk_cv.notify_all();
+    // The device's memory, its sums among it, is freed once they are added.
+    release_cv.wait(lock, [&] { return released; });
+    lock.unlock();
+    made.reset();
+  };
+  std::vector<std::thread> threads;
+  // Lets the devices free their memory, and waits until they have.
+  auto release_devices = [&] {
+    {
+      std::lock_guard<std::mutex> lock(m);
+      released = true;
+    }
+    release_cv.notify_all();
+    for (std::thread& t : threads) t.join();
   };
 
-  std::vector<std::thread> threads;
   for (size_t d = 0; d < devices; ++d) threads.emplace_back(work, d);
-  // This thread folds the finished chunks into the film in their order while the
-  // devices render the next ones; after_pass may stop the render after any chunk.
-  if (fed && options.progress) {
-    // Fed devices fold nothing until the end: progress is the paths handed out.
-    double all_paths = 0;
-    for (const SamplePass& c : chunks) all_paths += static_cast<double>(rp.width) * rp.height * c.count;
-    std::unique_lock<std::mutex> lock(m);
-    while (!chunk_cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop || working == 0; })) {
-      if (ready < devices) continue;
-      lock.unlock();
-      uint64_t rays = 0;
-      for (const std::atomic<uint64_t>& r : fed_rays) rays += r;
-      options.progress(std::min(1.0, static_cast<double>(feed.given()) / all_paths), rays,
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-      lock.lock();
+  // Waits until every device has ended, then lets them free their memory.
+  auto wind_down = [&] {
+    {
+      std::unique_lock<std::mutex> lock(m);
+      chunk_cv.wait(lock, [&] { return working == 0; });
     }
+    release_devices();
+  };
+  try {
+    // This thread folds the finished chunks into the film in their order while the
+    // devices render the next ones; after_pass may stop the render after any chunk.
+    if (fed && options.progress) {
+      // Fed devices fold nothing until the end: progress is the paths handed out.
+      double all_paths = 0;
+      for (const SamplePass& c : chunks) all_paths += static_cast<double>(rp.width) * rp.height * c.count;
+      std::unique_lock<std::mutex> lock(m);
+      while (!chunk_cv.wait_for(lock, std::chrono::milliseconds(250), [&] { return stop || working == 0; })) {
+        if (ready < devices) continue;
+        lock.unlock();
+        uint64_t rays = 0;
+        for (const std::atomic<uint64_t>& r : fed_rays) rays += r;
+        options.progress(std::min(1.0, static_cast<double>(feed.given()) / all_paths), rays,
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        lock.lock();
+      }
+    }
+    {
+      std::unique_lock<std::mutex> lock(m);
+      for (;;) {
+        chunk_cv.wait(lock, [&] { return stop || working == 0 || (folded < chunks.size() && finished[folded]); });
+        if (stop || folded == chunks.size() || !finished[folded]) break;
+        std::vector<float> sums = std::move(waiting[folded]);
+        lock.unlock();
+        if (!keep) {
+          for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
+        }
+        sums = {};
+        lock.lock();
+        out.samples = chunks[folded].first + chunks[folded].count;
+        ++folded;
+        if (options.after_pass || options.progress) {
+          uint64_t rays = 0;
+          for (const DeviceShare& s : out.shares) rays += s.rays;
+          const int32_t samples = out.samples;
+          lock.unlock();
+          const bool go_on = !options.after_pass || options.after_pass(samples, [&] { return out.rgb; });
+          if (go_on && options.progress) {
+            options.progress(static_cast<double>(folded) / chunks.size(), rays,
+                             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+          }
+          lock.lock();
+          if (!go_on) stop = true;
+        }
+      }
+    }
+  } catch (...) {
+    // after_pass or progress failed (a checkpoint that could not be written): the
+    // devices stop after their current chunk, and the render throws that error.
+    {
+      std::lock_guard<std::mutex> lock(m);
+      stop = true;
+    }
+    ready_cv.notify_all();
+    feed.stop();
+    wind_down();
+    throw;
+  }
+  if (error) {
+    wind_down();
+    split_detail::rethrow_naming(error, failed_device);
   }
   {
     std::unique_lock<std::mutex> lock(m);
-    for (;;) {
-      chunk_cv.wait(lock, [&] { return stop || working == 0 || (folded < chunks.size() && finished[folded]); });
-      if (stop || folded == chunks.size() || !finished[folded]) break;
-      std::vector<float> sums = std::move(waiting[folded]);
-      lock.unlock();
-      if (!keep) {
-        for (size_t i = 0; i < floats; ++i) out.rgb[i] += sums[i];
-      }
-      sums = {};
-      lock.lock();
-      out.samples = chunks[folded].first + chunks[folded].count;
-      ++folded;
-      if (options.after_pass || options.progress) {
-        uint64_t rays = 0;
-        for (const DeviceShare& s : out.shares) rays += s.rays;
-        const int32_t samples = out.samples;
-        lock.unlock();
-        const bool go_on = !options.after_pass || options.after_pass(samples, [&] { return out.rgb; });
-        if (go_on && options.progress) {
-          options.progress(static_cast<double>(folded) / chunks.size(), rays,
-                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-        }
-        lock.lock();
-        if (!go_on) stop = true;
-      }
-    }
+    chunk_cv.wait(lock, [&] { return working == 0; });
   }
-  for (std::thread& t : threads) t.join();
-  if (error) split_detail::rethrow_naming(error, failed_device);
-  if (keep) {
-    // In device order; the first film onto zeros is itself (x + 0 is x), the others
-    // are added by as many threads as the host has, each its own range of pixels.
-    size_t d = 0;
-    if (!options.initial_film) {
-      while (d < devices && kept[d].empty()) ++d;
-      if (d < devices) out.rgb = std::move(kept[d++]);
-    }
-    for (; d < devices; ++d) split_detail::add_in_parallel(out.rgb, kept[d]);
-  }
+  // In device order, onto zeros (the first device's sums are then the film itself:
+  // x + 0 is x) or onto the resumed film.
+  if (keep) split_detail::add_in_order(out.rgb, sums_of);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  release_devices();
   if (fed && !error) {
     // Every path was traced (a device that fails throws above): the whole render.
     folded = chunks.size();
