@@ -5,15 +5,17 @@
 # a process per job, with where each job's time went), and, where mpirun is found,
 # the same image and batch over two ranks. Prints one line a measurement.
 #   scripts/multi-gpu.sh BIN_DIR [OUT_DIR]
-# BACKEND, WIDTH, HEIGHT, SPP (the image), BATCH_SPP and KERNELS change the defaults
-# (cuda, 1920, 1080, 1200, 300, "megakernel wavefront"); with BACKEND=cpu it runs on
-# host "devices", to try the script on a machine without a GPU.
+# BACKEND, WIDTH, HEIGHT, SPP (the image), BATCH_SPP (the batches' jobs: a batch of
+# each) and KERNELS change the defaults (cuda, 1920, 1080, 1200, "300 1200",
+# "megakernel wavefront"); with BACKEND=cpu it runs on host "devices", to try the
+# script on a machine without a GPU. A batch of one job on one device shows what a
+# batch pays once whatever its length (starting CUDA and the worker, ending them).
 set -uo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 bin=$(cd "${1:?usage: multi-gpu.sh BIN_DIR [OUT_DIR]}" && pwd)
 out=${2:-$root/out/multi-gpu}
 backend=${BACKEND:-cuda} width=${WIDTH:-1920} height=${HEIGHT:-1080} spp=${SPP:-1200}
-batch_spp=${BATCH_SPP:-300} kernels=${KERNELS:-megakernel wavefront}
+batch_spp=${BATCH_SPP:-300 1200} kernels=${KERNELS:-megakernel wavefront}
 b="$bin/wavetrace"
 mkdir -p "$out"
 cd "$root"
@@ -45,14 +47,18 @@ PY
   done
 done
 
-python3 - "$root" "$out" "$backend" "$batch_spp" <<'PY'
+jobs_file() {  # jobs_file SPP COUNT: writes COUNT seed57 jobs of SPP samples; prints the file's path
+  python3 - "$root" "$out" "$backend" "$1" "$2" "$width" "$height" <<'PY'
 import json, sys
-root, out, backend, spp = sys.argv[1:5]
+root, out, backend, spp, n, width, height = sys.argv[1:8]
 jobs = [{"scene": root + "/scenes/seed57.json", "output": out + "/batch/j%02d.png" % i, "stats": out + "/batch/j%02d.json" % i,
-         "seed": i + 1} for i in range(16)]
-json.dump({"defaults": {"width": 1920, "height": 1080, "spp": int(spp), "depth": 30, "backend": backend, "kernel": "wavefront"},
-           "jobs": jobs}, open(out + "/jobs.json", "w"))
+         "seed": i + 1} for i in range(int(n))]
+path = out + "/jobs-%s-%s.json" % (spp, n)
+json.dump({"defaults": {"width": int(width), "height": int(height), "spp": int(spp), "depth": 30, "backend": backend, "kernel": "wavefront"},
+           "jobs": jobs}, open(path, "w"))
+print(path)
 PY
+}
 phases() {
   python3 - "$out/batch" <<'PY'
 import glob, json, statistics as st, sys
@@ -65,17 +71,32 @@ print('job %.3f s: render %.3f, scene %.3f, write %.3f, rest %.3f (medians)' % (
     med(lambda r: r['job_seconds'] - r['seconds'] - load(r) - r['upload_seconds'] - r['write_seconds'])))
 PY
 }
-for rep in 1 2; do
-  for mode in worker process-per-job; do
-    flag=""
-    [[ $mode == process-per-job ]] && flag=--process-per-job
-    for d in 0 "$all"; do
-      rm -rf "$out/batch" && mkdir -p "$out/batch"
-      start=$(date +%s.%N)
-      "$b" batch "$out/jobs.json" --devices "$d" $flag >"$out/batch.txt" 2>"$out/batch.err"
-      rc=$?
-      end=$(date +%s.%N)
-      echo "batch of 16 ($mode) on devices $d: rc $rc, $(seconds "$start" "$end") s; $(tail -1 "$out/batch.txt"); $(phases)"
+# batch FILE DEVICES [FLAGS...]: runs it into a clean output folder; sets rc and elapsed.
+batch() {
+  local file=$1 d=$2 start end
+  shift 2
+  rm -rf "$out/batch" && mkdir -p "$out/batch"
+  start=$(date +%s.%N)
+  "$b" batch "$file" --devices "$d" "$@" >"$out/batch.txt" 2>"$out/batch.err"
+  rc=$?
+  end=$(date +%s.%N)
+  elapsed=$(seconds "$start" "$end")
+}
+first_spp=${batch_spp%% *}
+for bspp in $batch_spp; do
+  batch "$(jobs_file "$bspp" 1)" 0
+  echo "batch of 1 job ($bspp spp) on device 0: rc $rc, $elapsed s; $(phases)"
+  file=$(jobs_file "$bspp" 16)
+  for rep in 1 2; do
+    for mode in worker process-per-job; do
+      # A process per job once, at the first size: it only adds each job's own start.
+      [[ $mode == process-per-job && ($rep == 2 || $bspp != "$first_spp") ]] && continue
+      flag=()
+      [[ $mode == process-per-job ]] && flag=(--process-per-job)
+      for d in 0 "$all"; do
+        batch "$file" "$d" "${flag[@]}"
+        echo "batch of 16 ($bspp spp, $mode) on devices $d: rc $rc, $elapsed s; $(tail -1 "$out/batch.txt"); $(phases)"
+      done
     done
   done
 done
@@ -92,8 +113,8 @@ if command -v mpirun >/dev/null; then
   done
   rm -rf "$out/batch" && mkdir -p "$out/batch"
   start=$(date +%s.%N)
-  timeout 300 mpirun --oversubscribe -n 2 "$b" batch "$out/jobs.json" >"$out/batch.txt" 2>"$out/batch.err"
+  timeout 300 mpirun --oversubscribe -n 2 "$b" batch "$(jobs_file "$first_spp" 16)" >"$out/batch.txt" 2>"$out/batch.err"
   rc=$?
   end=$(date +%s.%N)
-  echo "mpirun -n 2 batch of 16: rc $rc, $(seconds "$start" "$end") s; $(tail -1 "$out/batch.txt"); on rank 1: $(grep -c 'on rank 1' "$out/batch.err")"
+  echo "mpirun -n 2 batch of 16 ($first_spp spp): rc $rc, $(seconds "$start" "$end") s; $(tail -1 "$out/batch.txt"); on rank 1: $(grep -c 'on rank 1' "$out/batch.err")"
 fi
