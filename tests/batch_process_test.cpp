@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <set>
 #include <tuple>
 
@@ -324,6 +325,63 @@ done)sh");
   EXPECT_NE(seen[2].first, seen[3].first);
   EXPECT_EQ(seen[3].first, seen[4].first);
   EXPECT_NE(seen[4].first, seen[5].first);
+}
+
+// A lane with no job left ends its worker at once (freeing its GPU, or letting its
+// teardown overlap the other lanes' work), not at the end of the batch: the second
+// lane's job here waits for the first lane's worker to have ended.
+TEST_F(BatchProcessTest, ALaneOutOfJobsEndsItsWorkerWhileTheOtherLanesWork) {
+  const std::string started = (dir_ / "started1").string(), ended = (dir_ / "ended0").string();
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+wait_for() { n=0; while [ ! -e "$1" ] && [ $n -lt 100 ]; do sleep 0.05; n=$((n+1)); done; [ -e "$1" ]; }
+lane=none
+while read -r line; do
+  i=$(printf '%s' "$line" | sed 's/.*"index":\([0-9]*\).*/\1/')
+  lane=$(printf '%s' "$line" | sed -n 's/.*"--devices=\([0-9,]*\)".*/\1/p')
+  if [ "$lane" = 0 ]; then
+    wait_for ")sh" + started + R"sh("
+  else
+    touch ")sh" + started + R"sh("
+    if ! wait_for ")sh" + ended + R"sh("; then
+      echo "{\"index\":$i,\"exit_code\":1,\"message\":\"the other lane's worker still runs\"}" >&3
+      continue
+    fi
+  fi
+  echo "{\"index\":$i,\"exit_code\":0,\"backend\":\"cuda\",\"kernel\":\"wavefront\"}" >&3
+done
+[ "$lane" = 0 ] && touch ")sh" + ended + R"sh("
+exit 0)sh");
+  const auto [code, out, err] = batch(exe, jobs(2), false, {"0", "1"}, JobProcesses::PerLane);
+  EXPECT_EQ(code, 0) << out << err;
+  EXPECT_NE(out.find("2 jobs: 2 ok, 0 failed"), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(started)) << "the second lane ran no job";
+}
+
+// A first worker started before the batch (while its caller counts devices) is the
+// first lane's: it renders that lane's jobs, and no other process is started for them.
+TEST_F(BatchProcessTest, AWorkerStartedEarlyServesTheFirstLane) {
+  const std::string log = (dir_ / "log").string();
+  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
+while read -r line; do
+  i=$(printf '%s' "$line" | sed 's/.*"index":\([0-9]*\).*/\1/')
+  echo "$$" >> ")sh" + log + R"sh("
+  echo "{\"index\":$i,\"exit_code\":0,\"backend\":\"cpu\",\"kernel\":\"megakernel\"}" >&3
+done)sh");
+  auto first = std::make_unique<WorkerProcess>(exe);
+  first->start();
+  const pid_t pid = first->pid();
+  ASSERT_GT(pid, 0);
+  testing::internal::CaptureStdout();
+  const int code = run_batch_in_processes(jobs(3), false, exe, {""}, Cluster(), JobProcesses::PerLane, std::move(first));
+  const std::string out = testing::internal::GetCapturedStdout();
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_EQ(count(out, "3 jobs: 3 ok, 0 failed"), 1u) << out;
+  std::ifstream in(log);
+  int jobs_seen = 0;
+  for (pid_t p; in >> p; ++jobs_seen) EXPECT_EQ(p, pid);
+  EXPECT_EQ(jobs_seen, 3);
+  int status = 0;
+  EXPECT_EQ(::waitpid(pid, &status, WNOHANG), -1) << "the early worker was not waited for";
 }
 
 // A worker killed while it waits for its next question (from outside: the kernel's

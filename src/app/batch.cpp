@@ -19,6 +19,7 @@
 #include "app/distributed.hpp"
 #include "app/process.hpp"
 #include "app/signals.hpp"
+#include "cuda/device.hpp"
 
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -117,6 +118,8 @@ namespace {
 
 // Runs one job of a batch in lane `lane`: its outcome, whose message the batch prints.
 using JobRunner = std::function<JobOutcome(size_t lane, size_t index, const Job& job)>;
+// Called by a lane that has no job left (may be empty).
+using LaneDone = std::function<void(size_t lane)>;
 
 // The job as a lane runs it: on the lane's CUDA devices ("": the job's own), without
 // a progress line where lanes run at once.
@@ -191,11 +194,13 @@ class BatchRun {
 
   // A lane of this process: runs jobs with `run` until none is left. `devices`: the
   // lane's CUDA devices ("": the job's own); `quiet`: no progress lines (lanes at once).
-  void lane(const JobRunner& run, size_t lane_index, const std::string& devices, bool quiet) {
+  void lane(const JobRunner& run, size_t lane_index, const std::string& devices, bool quiet,
+            const LaneDone& done = {}) {
     while (const std::optional<size_t> i = take(devices.empty() ? "" : "cuda " + devices)) {
       if (settle(*i)) continue;
       record(*i, run(lane_index, *i, lane_job(jobs_[*i].job, devices, quiet)));
     }
+    if (done) done(lane_index);
   }
 
   // Prints the summary table and the count line; the batch's exit code.
@@ -247,13 +252,16 @@ class BatchRun {
 // `lanes`: the jobs run in as many lanes at once, each lane's CUDA jobs on its
 // devices ("" : the job's own); the summary lists them in the batch's order.
 int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunner& run,
-             const std::function<int()>& signal_caught, const std::vector<std::string>& lanes = {""}) {
+             const std::function<int()>& signal_caught, const std::vector<std::string>& lanes = {""},
+             const LaneDone& lane_done = {}) {
   BatchRun batch(jobs, skip_done, signal_caught);
   if (lanes.size() <= 1) {
-    batch.lane(run, 0, lanes.empty() ? std::string() : lanes[0], false);
+    batch.lane(run, 0, lanes.empty() ? std::string() : lanes[0], false, lane_done);
   } else {
     std::vector<std::thread> threads;
-    for (size_t l = 0; l < lanes.size(); ++l) threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], true); });
+    for (size_t l = 0; l < lanes.size(); ++l) {
+      threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], true, lane_done); });
+    }
     for (std::thread& t : threads) t.join();
   }
   return batch.summary();
@@ -448,12 +456,16 @@ void serve_ranks(const Cluster& cluster, BatchRun& batch, size_t remote_lanes) {
 
 // A lane of another rank than 0: asks rank 0 for jobs (its tag: the lane's number),
 // runs each as a process of its own on the lane's devices, and says how it went.
-void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool quiet, const JobRunner& run) {
+void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool quiet, const JobRunner& run,
+               const LaneDone& done) {
   json said = {{"host", cluster.host()}, {"devices", devices}};
   for (;;) {
     cluster.send(0, tag, said.dump());
     const std::string answer = cluster.receive(0, tag);
-    if (answer.empty()) return;
+    if (answer.empty()) {
+      done(static_cast<size_t>(tag));
+      return;
+    }
     const json given = json::parse(answer);
     const size_t index = given["index"].get<size_t>();
     JobOutcome o;
@@ -473,18 +485,28 @@ void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool
 }  // namespace
 
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
-                           const std::vector<std::string>& lanes, const Cluster& cluster, JobProcesses processes) {
+                           const std::vector<std::string>& lanes, const Cluster& cluster, JobProcesses processes,
+                           std::unique_ptr<WorkerProcess> first) {
   const SignalForwarder signals;
-  // A worker per lane (made before the lanes start, ended before the forwarder).
+  // A worker per lane (made before the lanes start, ended before the forwarder); the
+  // first may have been started already.
   std::vector<std::unique_ptr<WorkerProcess>> workers;
   if (processes == JobProcesses::PerLane) {
-    for (size_t l = 0; l < lanes.size(); ++l) workers.push_back(std::make_unique<WorkerProcess>(executable));
+    for (size_t l = 0; l < lanes.size(); ++l) {
+      workers.push_back(l == 0 && first ? std::move(first) : std::make_unique<WorkerProcess>(executable));
+    }
   }
   const JobRunner run = [&](size_t lane, size_t index, const Job& job) {
     return processes == JobProcesses::PerJob ? run_job_in_process(executable, index, job, signals)
                                              : run_job_in_worker(*workers.at(lane), index, job, signals);
   };
-  if (!cluster.distributed()) return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes);
+  // A lane out of jobs lets its worker end (freeing its GPU) while the others work.
+  const LaneDone lane_done = [&](size_t lane) {
+    if (lane < workers.size()) workers[lane]->finish();
+  };
+  if (!cluster.distributed()) {
+    return run_jobs(jobs, skip_done, run, [&] { return signals.caught(); }, lanes, lane_done);
+  }
 
   // An MPI run: every rank's lanes take jobs as they free up; rank 0 hands them out
   // and alone prints the summary.
@@ -493,7 +515,7 @@ int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, 
   std::vector<std::thread> threads;
   if (!cluster.root()) {
     for (size_t l = 0; l < lanes.size(); ++l) {
-      threads.emplace_back([&, l] { rank_lane(cluster, static_cast<int>(l), lanes[l], quiet, run); });
+      threads.emplace_back([&, l] { rank_lane(cluster, static_cast<int>(l), lanes[l], quiet, run, lane_done); });
     }
     for (std::thread& t : threads) t.join();
     return signals.caught() ? 128 + signals.caught() : 0;
@@ -501,7 +523,9 @@ int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, 
   size_t remote_lanes = 0;
   for (size_t r = 1; r < counts.size(); ++r) remote_lanes += std::stoul(counts[r]);
   BatchRun batch(jobs, skip_done, [&] { return signals.caught(); });
-  for (size_t l = 0; l < lanes.size(); ++l) threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], quiet); });
+  for (size_t l = 0; l < lanes.size(); ++l) {
+    threads.emplace_back([&, l] { batch.lane(run, l, lanes[l], quiet, lane_done); });
+  }
   serve_ranks(cluster, batch, remote_lanes);
   for (std::thread& t : threads) t.join();
   return batch.summary();
@@ -515,6 +539,9 @@ int run_batch_worker(int answers) {
                  answers);
     return kExitFailure;
   }
+  // CUDA starts (where there is a GPU) before the first job comes: the batch that
+  // started this worker first may still be counting its devices.
+  cuda::device_count();
   for (std::string line; std::getline(std::cin, line);) {
     const json asked = json::parse(line, nullptr, false);
     const size_t index = asked.is_object() ? asked.value("index", size_t(0)) : 0;

@@ -1,9 +1,11 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "app/job.hpp"
+#include "app/process.hpp"
 
 namespace wt::app {
 
@@ -37,7 +39,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
 // at the price of the process's and the context's set-up every job. SIGINT and
 // SIGTERM sent to this process are passed on to the running jobs, and the batch stops
 // after them with 128 + the signal; a job killed by another signal fails alone. This
-// process never calls CUDA.
+// process renders nothing itself.
 // The lanes a batch runs its jobs in at once (run_batch_in_processes): one per CUDA
 // device of `devices` ("all" or a list; `present` devices), or with fewer jobs than
 // devices one per job, each over its share of them; a single lane ("": the jobs'
@@ -50,10 +52,14 @@ std::vector<std::string> batch_lanes(const std::string& devices, const std::stri
 // As a rank of an MPI run (every rank calls it), rank 0 hands the jobs of `jobs` out
 // to every rank's lanes as they free up and alone prints the summary; the other
 // ranks' `jobs` are not read.
+// `first`, where given, is the first lane's worker, started early (a worker process
+// starts CUDA before its first job; the caller may count devices meanwhile). A lane
+// with no job left ends its worker at once.
 enum class JobProcesses { PerLane, PerJob };
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
                            const std::vector<std::string>& lanes = {""}, const Cluster& cluster = Cluster(),
-                           JobProcesses processes = JobProcesses::PerLane);
+                           JobProcesses processes = JobProcesses::PerLane,
+                           std::unique_ptr<WorkerProcess> first = nullptr);
 
 // `wavetrace worker`, the process a batch lane keeps: reads questions from stdin, a
 // line each ({"index": N, "args": the job's render_arguments}), renders each job as

@@ -283,6 +283,7 @@ WorkerProcess::WorkerProcess(std::string executable) : executable_(std::move(exe
 WorkerProcess::~WorkerProcess() { stop(); }
 
 void WorkerProcess::start() {
+  if (pid_ != 0) return;
   const int slot = take_slot();
   std::array<int, 2> to{-1, -1}, from{-1, -1};
   try {
@@ -310,6 +311,7 @@ std::optional<std::string> WorkerProcess::ask(const std::string& question, Child
   // question has not reached it. So is one gone before it read the question.
   int status = 0;
   if (pid_ != 0 && ::waitpid(pid_, &status, WNOHANG) == pid_) release();
+  if (pid_ != 0 && to_ < 0) stop();  // finished: it is ending
   if (pid_ == 0) start();
   bool sent = write_or_gone(to_, question + "\n");
   if (!sent) {
@@ -338,12 +340,17 @@ std::optional<std::string> WorkerProcess::ask(const std::string& question, Child
   return std::nullopt;
 }
 
+void WorkerProcess::finish() {
+  if (to_ >= 0) ::close(to_);
+  to_ = -1;
+}
+
 ChildEnd WorkerProcess::stop() {
   if (pid_ == 0) return {};
   // Its input closed, it exits; its answers, closed, cannot hold it up.
-  ::close(to_);
+  finish();
   ::close(from_);
-  to_ = from_ = -1;
+  from_ = -1;
   const ChildEnd end = wait_for(pid_);
   release();
   return end;
