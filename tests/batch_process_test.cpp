@@ -357,33 +357,6 @@ exit 0)sh");
   EXPECT_TRUE(fs::exists(started)) << "the second lane ran no job";
 }
 
-// A first worker started before the batch (while its caller counts devices) is the
-// first lane's: it renders that lane's jobs, and no other process is started for them.
-TEST_F(BatchProcessTest, AWorkerStartedEarlyServesTheFirstLane) {
-  const std::string log = (dir_ / "log").string();
-  const std::string exe = script(R"sh([ "$1" = worker ] || exit 9
-while read -r line; do
-  i=$(printf '%s' "$line" | sed 's/.*"index":\([0-9]*\).*/\1/')
-  echo "$$" >> ")sh" + log + R"sh("
-  echo "{\"index\":$i,\"exit_code\":0,\"backend\":\"cpu\",\"kernel\":\"megakernel\"}" >&3
-done)sh");
-  auto first = std::make_unique<WorkerProcess>(exe);
-  first->start();
-  const pid_t pid = first->pid();
-  ASSERT_GT(pid, 0);
-  testing::internal::CaptureStdout();
-  const int code = run_batch_in_processes(jobs(3), false, exe, {""}, Cluster(), JobProcesses::PerLane, std::move(first));
-  const std::string out = testing::internal::GetCapturedStdout();
-  EXPECT_EQ(code, 0) << out;
-  EXPECT_EQ(count(out, "3 jobs: 3 ok, 0 failed"), 1u) << out;
-  std::ifstream in(log);
-  int jobs_seen = 0;
-  for (pid_t p; in >> p; ++jobs_seen) EXPECT_EQ(p, pid);
-  EXPECT_EQ(jobs_seen, 3);
-  int status = 0;
-  EXPECT_EQ(::waitpid(pid, &status, WNOHANG), -1) << "the early worker was not waited for";
-}
-
 // A worker killed while it waits for its next question (from outside: the kernel's
 // out-of-memory killer, a user) is replaced before the question is sent, so the job
 // is asked of a live worker rather than failed.

@@ -19,7 +19,6 @@
 #include "app/distributed.hpp"
 #include "app/process.hpp"
 #include "app/signals.hpp"
-#include "cuda/device.hpp"
 
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -485,16 +484,12 @@ void rank_lane(const Cluster& cluster, int tag, const std::string& devices, bool
 }  // namespace
 
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
-                           const std::vector<std::string>& lanes, const Cluster& cluster, JobProcesses processes,
-                           std::unique_ptr<WorkerProcess> first) {
+                           const std::vector<std::string>& lanes, const Cluster& cluster, JobProcesses processes) {
   const SignalForwarder signals;
-  // A worker per lane (made before the lanes start, ended before the forwarder); the
-  // first may have been started already.
+  // A worker per lane (made before the lanes start, ended before the forwarder).
   std::vector<std::unique_ptr<WorkerProcess>> workers;
   if (processes == JobProcesses::PerLane) {
-    for (size_t l = 0; l < lanes.size(); ++l) {
-      workers.push_back(l == 0 && first ? std::move(first) : std::make_unique<WorkerProcess>(executable));
-    }
+    for (size_t l = 0; l < lanes.size(); ++l) workers.push_back(std::make_unique<WorkerProcess>(executable));
   }
   const JobRunner run = [&](size_t lane, size_t index, const Job& job) {
     return processes == JobProcesses::PerJob ? run_job_in_process(executable, index, job, signals)
@@ -539,9 +534,6 @@ int run_batch_worker(int answers) {
                  answers);
     return kExitFailure;
   }
-  // CUDA starts (where there is a GPU) before the first job comes: the batch that
-  // started this worker first may still be counting its devices.
-  cuda::device_count();
   for (std::string line; std::getline(std::cin, line);) {
     const json asked = json::parse(line, nullptr, false);
     const size_t index = asked.is_object() ? asked.value("index", size_t(0)) : 0;

@@ -1,11 +1,9 @@
 #pragma once
 
-#include <memory>
 #include <string>
 #include <vector>
 
 #include "app/job.hpp"
-#include "app/process.hpp"
 
 namespace wt::app {
 
@@ -52,14 +50,11 @@ std::vector<std::string> batch_lanes(const std::string& devices, const std::stri
 // As a rank of an MPI run (every rank calls it), rank 0 hands the jobs of `jobs` out
 // to every rank's lanes as they free up and alone prints the summary; the other
 // ranks' `jobs` are not read.
-// `first`, where given, is the first lane's worker, started early (a worker process
-// starts CUDA before its first job; the caller may count devices meanwhile). A lane
-// with no job left ends its worker at once.
+// A lane with no job left ends its worker at once.
 enum class JobProcesses { PerLane, PerJob };
 int run_batch_in_processes(const std::vector<PlannedJob>& jobs, bool skip_done, const std::string& executable,
                            const std::vector<std::string>& lanes = {""}, const Cluster& cluster = Cluster(),
-                           JobProcesses processes = JobProcesses::PerLane,
-                           std::unique_ptr<WorkerProcess> first = nullptr);
+                           JobProcesses processes = JobProcesses::PerLane);
 
 // `wavetrace worker`, the process a batch lane keeps: reads questions from stdin, a
 // line each ({"index": N, "args": the job's render_arguments}), renders each job as

@@ -166,17 +166,6 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   // Each job runs as `wavetrace render` in a process of its own: a clean CUDA context
   // for every job, whatever the one before it did to its own. With several CUDA
   // devices the jobs run at once, a device (or a share of them) each.
-  // The first lane's worker starts now: its CUDA start (a fraction of a second on a
-  // host where no process holds the GPUs) overlaps this process's count of devices.
-  std::unique_ptr<wt::app::WorkerProcess> first;
-  if (processes == wt::app::JobProcesses::PerLane && !jobs.empty()) {
-    first = std::make_unique<wt::app::WorkerProcess>("/proc/self/exe");
-    try {
-      first->start();
-    } catch (const std::exception&) {
-      first.reset();  // the lane starts it itself, and its jobs say what went wrong
-    }
-  }
   std::vector<std::string> lanes;
   try {
     const int present = batch_job.backend == "cpu" ? 0 : wt::cuda::device_count();
@@ -186,8 +175,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
   }
-  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster, processes,
-                                         std::move(first));
+  return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster, processes);
 }
 
 }  // namespace

@@ -283,7 +283,6 @@ WorkerProcess::WorkerProcess(std::string executable) : executable_(std::move(exe
 WorkerProcess::~WorkerProcess() { stop(); }
 
 void WorkerProcess::start() {
-  if (pid_ != 0) return;
   const int slot = take_slot();
   std::array<int, 2> to{-1, -1}, from{-1, -1};
   try {

@@ -59,9 +59,6 @@ class WorkerProcess {
   // new one. A process found ended before it got the question is replaced at once.
   // Throws std::runtime_error if it cannot be started.
   std::optional<std::string> ask(const std::string& question, ChildEnd& end);
-  // Starts the process now, where it is not running (ask() starts it when needed): its
-  // start then overlaps whatever the caller does next. Throws as ask().
-  void start();
   // Closes its input, which ends it, and waits for it to exit; its end.
   ChildEnd stop();
   // Closes its input, which ends it, without waiting (stop() waits): a lane done with
@@ -71,6 +68,7 @@ class WorkerProcess {
   pid_t pid() const { return pid_; }
 
  private:
+  void start();
   // Forgets the process (its exit already waited for): its pipes and signal slot.
   void release();
   std::string executable_;
