@@ -65,6 +65,33 @@ TEST(Push, GpuWarpsGetDistinctConsecutiveSlots) {
 
 // ---------- the wave's layout ----------
 
+// A pass's paths visit every pixel once a sample, in tiles of 8 x 4: whole tiles
+// inside the image, narrower or lower ones at its right and bottom edges.
+TEST(PathPixel, EverySampleVisitsEveryPixelOnceInTilesOfEightByFour) {
+  for (auto [w, h] : {std::pair<uint32_t, uint32_t>{16, 8}, {21, 11}, {1, 1}, {7, 3}, {1920, 1080}, {9, 5}}) {
+    const uint32_t pixels = w * h;
+    std::vector<int> seen(pixels, 0);
+    for (uint32_t path = 0; path < pixels; ++path) {
+      const uint32_t p = path_pixel(path, w, h);
+      ASSERT_LT(p, pixels) << w << "x" << h << " path " << path;
+      ++seen[p];
+      // The next sample's path lands on the same pixel.
+      ASSERT_EQ(path_pixel(path + pixels, w, h), p);
+    }
+    for (uint32_t p = 0; p < pixels; ++p) ASSERT_EQ(seen[p], 1) << w << "x" << h << " pixel " << p;
+  }
+  // 16 x 8: the first warp's 32 paths are the top-left 8 x 4 tile, row by row.
+  for (uint32_t path = 0; path < 32; ++path) EXPECT_EQ(path_pixel(path, 16, 8), (path / 8) * 16 + path % 8) << path;
+  // The next tile is to its right; the tile row below starts at path 64.
+  EXPECT_EQ(path_pixel(32, 16, 8), 8u);
+  EXPECT_EQ(path_pixel(64, 16, 8), 4u * 16);
+  // 9 x 5: the right edge's tiles are 1 wide, the bottom band 1 high.
+  EXPECT_EQ(path_pixel(32, 9, 5), 8u);
+  EXPECT_EQ(path_pixel(33, 9, 5), 9u + 8);
+  EXPECT_EQ(path_pixel(36, 9, 5), 4u * 9);
+  EXPECT_EQ(path_pixel(44, 9, 5), 4u * 9 + 8);
+}
+
 TEST(WaveLayout, EveryArrayIsAlignedDisjointAndInsideTheBlock) {
   const size_t capacity = 1000, temp = 777;
   size_t bytes = 0;

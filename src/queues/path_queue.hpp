@@ -14,10 +14,35 @@ namespace wt {
 struct PathState {
   Ray ray;
   vec3 throughput;
-  uint32_t path;    // path index within its pass: pixel = path % pixels, sample = pass's first + path / pixels
+  uint32_t path;    // path index within its pass: pixel = path_pixel(path), sample = pass's first + path / pixels
   uint32_t bounce;  // rays this path has traced so far
   float pdf;        // the last bounce's BSDF density (0: specular, or the camera), for MIS
 };
+
+// The pixel of path `path` of a pass (of width x height pixels a sample): the pass
+// takes its pixels in tiles of 8 x 4, a row of tiles after another (the tiles at the
+// right and bottom edges narrower or lower), so that the 32 slots of a warp start
+// their rays at neighbouring pixels in both directions, as a megakernel warp does;
+// every sample of a pass visits every pixel once.
+WT_HD WT_INLINE uint32_t path_pixel(uint32_t path, uint32_t width, uint32_t height) {
+  constexpr uint32_t kTileWidth = 8, kTileHeight = 4, kTile = kTileWidth * kTileHeight;
+  const uint32_t p = path % (width * height);
+  const uint32_t band = p / (width * kTileHeight);  // a row of tiles
+  const uint32_t y0 = band * kTileHeight;
+  const uint32_t q = p - band * width * kTileHeight;  // within the band
+  if (y0 + kTileHeight <= height) {
+    const uint32_t x0 = q / kTile * kTileWidth;
+    // A whole tile: shifts and masks (the common case, on the path of every bounce).
+    if (x0 + kTileWidth <= width) return (y0 + q % kTile / kTileWidth) * width + x0 + q % kTileWidth;
+  }
+  // The right and bottom edges: tiles of w x h.
+  const uint32_t h = height - y0 < kTileHeight ? height - y0 : kTileHeight;
+  const uint32_t tile = q / (kTileWidth * h);
+  const uint32_t x0 = tile * kTileWidth;
+  const uint32_t w = width - x0 < kTileWidth ? width - x0 : kTileWidth;
+  const uint32_t r = q - tile * kTileWidth * h;
+  return (y0 + r / w) * width + x0 + r % w;
+}
 
 // A light sample waiting for its shadow ray (path.hpp's ShadowRay, and the pixel
 // it lights).

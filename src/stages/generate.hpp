@@ -20,7 +20,7 @@ WT_HD WT_INLINE PathState start_path(uint32_t slot, uint32_t queued, uint32_t ne
   s.bounce = 0;
   s.throughput = vec3(1.0f);
   s.pdf = 0.0f;
-  s.ray = primary_ray(scene, rp, s.path % pixels, first_sample + s.path / pixels);
+  s.ray = primary_ray(scene, rp, path_pixel(s.path, rp.width, rp.height), first_sample + s.path / pixels);
   return s;
 }
 

@@ -21,9 +21,8 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
   Hit h = intersect_scene<Kinds>(scene, ray);
   store_hit<Kinds>(hits, i, h);
   if (h.missed()) {
-    const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);
-    accumulate_one(film, q.path[i] % pixels, t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
+    accumulate_one(film, path_pixel(q.path[i], rp.width, rp.height), t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
     return pack_entry(kSortKeyMiss, i);
   }
   return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);

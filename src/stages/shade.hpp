@@ -21,7 +21,7 @@ WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene
                                ShadowRay& shadow, uint32_t& pixel) {
   PathState s = q.load(slot);
   const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
-  pixel = s.path % pixels;
+  pixel = path_pixel(s.path, rp.width, rp.height);
   vec3 radiance(0.0f);
   bool alive = shade_hit<Kinds>(scene, rp, load_hit<Kinds>(hits, slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
                                 s.throughput, radiance, s.pdf, shadow);
