@@ -3,7 +3,6 @@
 // and backends.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -119,67 +118,6 @@ TEST(CornellBox, CpuWavefrontIsBitIdenticalToCpuMegakernel) {
 TEST(CornellBox, EveryCudaKernelAgreesWithTheCpuMegakernel) {
   WT_REQUIRE_CUDA();
   test::expect_cuda_agrees_with_cpu([](Backend b, Kernel k, uint32_t seed) { return render_cornell(b, k, 8, seed); }, 5);
-}
-
-// ---- Fetching warps ----
-
-// The CUDA wavefront traces scenes with triangles in fetching warps
-// (cuda/executor.cuh): once fewer than fetch_min_busy of a warp's lanes still trace,
-// the done ones take new slots. Whatever the threshold (1: only when every lane is
-// done; 32: as soon as one is), every slot must get the hit a thread of its own
-// gives it (0): the same rays and shadow rays, and the same image up to the order
-// of the film's atomic additions. The scenes: the Cornell box with light sampling
-// (shadow rays, emitters), and spheres beside transformed triangle instances. Small
-// waves make every bounce drain its slots and regenerate.
-TEST(FetchingWarps, EveryThresholdTracesWhatAThreadARayTraces) {
-  WT_REQUIRE_CUDA();
-  test::TestFolder folder;
-  test::write_obj((folder.root() / "cube.obj").string(), test::cube());
-  test::write_obj((folder.root() / "ball.obj").string(), test::icosphere(2));
-  const Scene mixed = parse_scene(R"({
-    "camera": {"look_from": [0, 2, 7], "look_at": [0, 0, 0], "vfov": 45},
-    "materials": [{"name": "white", "type": "lambertian", "albedo": [0.8, 0.8, 0.8]},
-                  {"name": "glass", "type": "dielectric", "ior": 1.5},
-                  {"name": "steel", "type": "metal", "albedo": [0.9, 0.9, 0.9], "fuzz": 0.1}],
-    "spheres": [{"center": [0, -1001, 0], "radius": 1000, "material": "white"},
-                {"center": [-1.8, 0, 0], "radius": 0.8, "material": "glass"}],
-    "meshes": [{"name": "cube", "file": "cube.obj", "material": "white"},
-               {"name": "ball", "file": "ball.obj", "material": "steel"}],
-    "instances": [{"mesh": "cube", "rotate": [35, 45, 10], "scale": [0.9, 0.8, 1.0]},
-                  {"mesh": "ball", "translate": [1.8, 0, 0], "scale": 0.9},
-                  {"mesh": "ball", "translate": [0, 0, -2.5], "material": "glass"}]
-  })",
-                                  (folder.root() / "mixed.json").string());
-  const Scene cornell = load_scene(test::repo_path("scenes/cornell-box.json"));
-  for (const Scene* scene : {&cornell, &mixed}) {
-    RenderOptions o = options_for(Backend::Cuda, Kernel::Wavefront, 64, 48, 4, 8, 3, 11);
-    o.wave_size = 2048;
-    o.fetch_min_busy = 0;
-    const RenderResult plain = render(*scene, o);
-    ASSERT_GT(mean(plain.rgb), 0.01) << scene->source;
-    const float largest = *std::max_element(plain.rgb.begin(), plain.rgb.end());
-    for (int min_busy : {1, 8, kDefaultFetchMinBusy, 32}) {
-      o.fetch_min_busy = min_busy;
-      const RenderResult fetched = render(*scene, o);
-      EXPECT_EQ(fetched.rays, plain.rays) << scene->source << ", " << min_busy;
-      EXPECT_EQ(fetched.shadow_rays, plain.shadow_rays) << scene->source << ", " << min_busy;
-      ASSERT_EQ(fetched.rgb.size(), plain.rgb.size());
-      double worst = 0;
-      for (size_t i = 0; i < plain.rgb.size(); ++i) {
-        worst = std::max(worst, std::fabs(static_cast<double>(fetched.rgb[i]) - plain.rgb[i]));
-      }
-      EXPECT_LE(worst, 1e-5 * largest) << scene->source << ", " << min_busy;
-    }
-  }
-}
-
-TEST(FetchingWarps, AThresholdBeyondAWarpIsRefused) {
-  const Scene scene = load_scene(test::repo_path("scenes/cornell-box.json"));
-  RenderOptions o = options_for(Backend::Cpu, Kernel::Wavefront, 8, 8, 1, 4, 3, 1);
-  o.fetch_min_busy = 33;
-  EXPECT_THROW(render(scene, o), SceneError);
-  o.fetch_min_busy = -1;
-  EXPECT_THROW(render(scene, o), SceneError);
 }
 
 }  // namespace

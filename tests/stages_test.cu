@@ -168,7 +168,7 @@ TYPED_TEST(Stages, IntersectStartsCameraPathsInTheFreeSlots) {
   // 0); the free slots 5..15 start paths 40..50.
   Side::upload(w.counters, std::vector<WaveCounters>{WaveCounters{{5, 0}, 40, 0, 0}});
   this->ex->launch(stage::kIntersect, 16,
-                   IntersectItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 16, film, kDefaultFetchMinBusy});
+                   IntersectItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 16, film});
   std::vector<ImageView> images;
   const SceneView host = host_view(scene, kParams.width, kParams.height, images);
   for (uint32_t slot = 5; slot < 16; ++slot) {
@@ -242,7 +242,7 @@ TYPED_TEST(Stages, IntersectFindsClosestHitsAddsSkyForMissesAndCountsRays) {
   // All paths handed out: live = queued = 4; slots 4..7 must come out as misses.
   Side::upload(w.counters, std::vector<WaveCounters>{WaveCounters{{4, 77}, kTotal, 0, 100}});
   this->ex->launch(stage::kIntersect, 8,
-                   IntersectItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 8, film, kDefaultFetchMinBusy});
+                   IntersectItem<kAllKinds>{sd.view, kParams, w.queue[0], w.hits, w.entries, w.counters, 0, kTotal, 0, 8, film});
   this->ex->launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, 0, kTotal, 8});
 
   const auto t = Side::download(w.hits.t, 4);

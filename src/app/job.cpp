@@ -81,8 +81,6 @@ void set_setting(Job& job, SettingId id, int64_t value) {
     job.warmup = value;
   } else if (id == SettingId::WaveSize) {
     job.wave_size = value;
-  } else if (id == SettingId::FetchMinBusy) {
-    job.fetch_min_busy = value;
   } else if (id == SettingId::Threads) {
     job.threads = value;
   } else if (id == SettingId::CheckpointEvery) {
@@ -97,7 +95,6 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
   switch (id) {
     case SettingId::Warmup: return unless_default(job.warmup, defaults.warmup);
     case SettingId::WaveSize: return unless_default(job.wave_size, defaults.wave_size);
-    case SettingId::FetchMinBusy: return unless_default(job.fetch_min_busy, defaults.fetch_min_busy);
     case SettingId::Threads: return unless_default(job.threads, defaults.threads);
     case SettingId::CheckpointEvery: return unless_default(job.checkpoint_every, defaults.checkpoint_every);
     default: return std::nullopt;
@@ -249,7 +246,6 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     options.backend = parse_backend(job.backend);
     options.warmup = static_cast<int>(job.warmup);
     options.wave_size = job.wave_size;
-    options.fetch_min_busy = static_cast<int>(job.fetch_min_busy);
     options.threads = static_cast<int>(job.threads);
     options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
     out.params = options.params;

@@ -23,7 +23,6 @@ struct Job {
   std::string kernel = "megakernel";
   int64_t warmup = 0;
   int64_t wave_size = 0;  // 0: chosen at run time
-  int64_t fetch_min_busy = kDefaultFetchMinBusy;
   int64_t threads = 0;    // 0: every core
   // The devices to split the render over: "all" (every CUDA device; on the CPU
   // backend, one), or indices "0,1" (on the CPU backend, as many host "devices").

@@ -103,7 +103,6 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["settings"] = settings_json(o.params);
   j["settings"][setting(SettingId::Warmup).key] = job.warmup;
   j["settings"][setting(SettingId::WaveSize).key] = job.wave_size;
-  j["settings"][setting(SettingId::FetchMinBusy).key] = job.fetch_min_busy;
   j["backend"] = o.backend;
   j["kernel"] = o.kernel;
   j["device"] = r.device;

@@ -9,14 +9,12 @@
 #include <cub/device/device_select.cuh>
 #include <algorithm>
 #include <cstring>
-#include <utility>
 #include <memory>
 #include <type_traits>
 #include <vector>
 
 #include "cuda/buffer.hpp"
 #include "cuda/event.hpp"
-#include "wavetrace/path.hpp"
 #include "stages/compact.hpp"
 #include "stages/sort.hpp"
 #include "stages/stage.hpp"
@@ -51,99 +49,6 @@ __global__ void __launch_bounds__(kBoundedBlock, MinBlocksPerSm<Item>::value)
   if (i < n) item(i);
 }
 
-// Items that a warp can run as fetching lanes (IntersectItem for scenes with
-// triangles): they declare kFetching and give their work in parts (wave, begin, a
-// Walk, finish, skip; stages/intersect.hpp).
-template <class Item, class = void>
-struct Fetching : std::false_type {};
-template <class Item>
-struct Fetching<Item, std::enable_if_t<Item::kFetching>> : std::true_type {};
-
-// A walk resumed for one step.
-struct OneStep {
-  bool taken = false;
-  __device__ bool operator()() {
-    if (taken) return true;
-    taken = true;
-    return false;
-  }
-};
-
-// Slots a warp takes from the fetch counter at once: one atomic per this many walks.
-constexpr uint32_t kFetchChunk = 128;
-
-// Fetching warps (after Aila and Laine's persistent threads with dynamic fetch): a
-// thread a slot lets a warp run until its longest walk ends, and the bounce rays of
-// a large mesh scene leave most lanes idle that way (7 of 32 busy on the terrain).
-// Here the warp steps its lanes' walks together, one traversal step a turn; once
-// fewer than `min_busy` lanes are still walking, the done lanes finish their slots
-// together and take new ones, all the warp's at once, so that the code before and
-// after a walk runs once for many lanes, not once for each. Once the counter is
-// drained, the walks left run to their ends. Slots past the live ones get their
-// skip entries afterwards. Every slot gets the hit and entry a thread of its own
-// would give it.
-template <class Item>
-__global__ void __launch_bounds__(kBoundedBlock, MinBlocksPerSm<Item>::value)
-    fetching_kernel(Item item, uint32_t n, int min_busy) {
-  using Walk = typename Item::Walk;
-  constexpr unsigned kAll = 0xffffffffu;
-  const auto w = item.wave();
-  const uint32_t live = w.live < n ? w.live : n;
-  const unsigned lane = threadIdx.x & 31u;
-  const unsigned below = (1u << lane) - 1u;
-  uint32_t* const counter = item.fetch_counter();
-  Walk walk;
-  int stack[Walk::kStack];
-  float stack_t[Walk::kStack];
-  uint32_t slot = 0;
-  bool busy = false;
-  // The warp's slots taken from the counter and not yet handed to a lane (the same
-  // in every lane), and whether the counter has none left.
-  uint32_t pool = 0, pool_end = 0;
-  bool drained = false;
-  bool pending = false;  // walked to its end, not yet finished
-  for (;;) {
-    const unsigned walking = __ballot_sync(kAll, busy);
-    if (__popc(walking) < min_busy || walking == 0) {
-      // The done lanes finish their slots together and take new ones.
-      if (pending) {
-        item.finish(slot, walk.world, walk.hit);
-        pending = false;
-      }
-      unsigned idle = __ballot_sync(kAll, !busy);
-      while (idle != 0 && !drained) {
-        if (pool == pool_end) {
-          uint32_t base = 0;
-          if (lane == 0) base = atomicAdd(counter, kFetchChunk);
-          base = __shfl_sync(kAll, base, 0);
-          if (base >= live) {
-            drained = true;
-            break;
-          }
-          pool = base;
-          pool_end = min(base + kFetchChunk, live);
-        }
-        const uint32_t handed = min(static_cast<uint32_t>(__popc(idle)), pool_end - pool);
-        const uint32_t rank = static_cast<uint32_t>(__popc(idle & below));
-        if (!busy && rank < handed) {
-          slot = pool + rank;
-          busy = walk.start(item.scene, item.begin(slot, w), kRayTMax);
-          if (!busy) item.finish(slot, walk.world, walk.hit);  // nothing to walk
-        }
-        pool += handed;
-        idle = __ballot_sync(kAll, !busy);
-      }
-      if (__ballot_sync(kAll, busy) == 0) break;
-    }
-    // One step of every walking lane, the warp together.
-    if (busy && walk.resume(item.scene, stack, stack_t, OneStep{})) {
-      busy = false;
-      pending = true;
-    }
-  }
-  for (uint32_t i = live + blockIdx.x * blockDim.x + threadIdx.x; i < n; i += gridDim.x * blockDim.x) item.skip(i);
-}
-
 // The kernel that runs Item over a range.
 template <class Item>
 constexpr auto stage_kernel() {
@@ -154,34 +59,32 @@ constexpr auto stage_kernel() {
   }
 }
 
-// The block size for `kernel` (stage_kernel<Item>() or fetching_kernel<Item>), asked
-// of the occupancy API once per item type and kernel: the smallest block that
-// reaches the highest occupancy the kernel can have, in steps of four warps, one for
-// each of an SM's four schedulers. Smaller blocks at the same occupancy leave less of
-// the device idle while the last blocks of a launch finish; blocks of fewer than four
-// warps leave schedulers without work. Measured on the H100 against the occupancy
-// API's own pick (the largest block at the highest occupancy) and against one warp
-// steps: bench/RESULTS.md. Also gives the blocks of that size an SM holds.
-template <class Item, class Kernel>
-std::pair<int, int> block_size_for(const Stage& s, Kernel kernel) {
-  static const std::pair<int, int> block = [&] {
+// The block size for stage_kernel<Item>(), asked of the occupancy API once per
+// item type: the smallest block that reaches the highest occupancy the kernel can
+// have, in steps of four warps, one for each of an SM's four schedulers. Smaller
+// blocks at the same occupancy leave less of the device idle while the last blocks
+// of a launch finish; blocks of fewer than four warps leave schedulers without
+// work. Measured on the H100 against the occupancy API's own pick (the largest
+// block at the highest occupancy) and against one warp steps: bench/RESULTS.md.
+template <class Item>
+int block_size_for(const Stage& s) {
+  static const int block = [&] {
     cudaFuncAttributes attributes{};
-    WT_CUDA(cudaFuncGetAttributes(&attributes, kernel), s.name);
+    WT_CUDA(cudaFuncGetAttributes(&attributes, stage_kernel<Item>()), s.name);
     int device = 0, warp = 0;
     WT_CUDA(cudaGetDevice(&device), s.name);
     WT_CUDA(cudaDeviceGetAttribute(&warp, cudaDevAttrWarpSize, device), s.name);
     const int step = 4 * warp;
-    int best = step, best_threads = 0, best_blocks = 1;
+    int best = step, best_threads = 0;
     for (int size = step; size <= attributes.maxThreadsPerBlock; size += step) {
       int blocks = 0;
-      WT_CUDA(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, kernel, size, 0), s.name);
+      WT_CUDA(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&blocks, stage_kernel<Item>(), size, 0), s.name);
       if (blocks * size > best_threads) {
         best_threads = blocks * size;
         best = size;
-        best_blocks = blocks;
       }
     }
-    return std::pair<int, int>(best, best_blocks);
+    return best;
   }();
   return block;
 }
@@ -217,25 +120,7 @@ class Executor {
   template <class Item>
   void launch(const Stage& s, uint32_t n, const Item& item) {
     if (n == 0) return;
-    if constexpr (Fetching<Item>::value) {
-      const int min_busy = item.min_busy;
-      if (min_busy > 0) {
-        const std::pair<int, int> shape = block_size_for<Item>(s, fetching_kernel<Item>);
-        const int block = shape.first, per_sm = shape.second;
-        // As many warps as the device runs at once, and no more than the slots need.
-        int device = 0, sms = 0;
-        WT_CUDA(cudaGetDevice(&device), s.name);
-        WT_CUDA(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), s.name);
-        const uint32_t most = static_cast<uint32_t>(sms * per_sm);
-        const int grid = static_cast<int>(std::min<uint32_t>((n + block - 1) / block, most));
-        timed(s, [&] {
-          fetching_kernel<Item><<<grid, block, 0, stream_>>>(item, n, min_busy);
-          check(static_cast<int>(cudaGetLastError()), "kernel launch", s.name);
-        });
-        return;
-      }
-    }
-    const int block = block_size_for<Item>(s, stage_kernel<Item>()).first;
+    const int block = block_size_for<Item>(s);
     timed(s, [&] {
       stage_kernel<Item>()<<<(n + block - 1) / block, block, 0, stream_>>>(item, n);
       check(static_cast<int>(cudaGetLastError()), "kernel launch", s.name);

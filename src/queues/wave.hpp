@@ -22,7 +22,7 @@ struct WaveCounters {
   // which decide whether that bounce is sorted; each bounce's counter update clears
   // the next bounce's.
   uint32_t key_mask[2];
-  uint32_t fetched;  // slots the GPU's fetching warps have taken this bounce (IntersectItem)
+  uint32_t unused;
   uint64_t shadow_rays;  // shadow rays traced, all bounces
 };
 

@@ -85,19 +85,12 @@ class PathFeed {
 // no pass holds more paths than this, so any number of paths can be rendered.
 constexpr uint64_t kMaxPathsPerPass = 0xffffffffull;
 
-// The CUDA wavefront's intersect on scenes with triangles runs fetching warps
-// (cuda/executor.cuh): once fewer than this many of a warp's 32 lanes are still
-// tracing, the lanes that are done take new rays. 0: a thread a ray. Measured:
-// bench/RESULTS.md.
-constexpr int kDefaultFetchMinBusy = 20;
-
 struct RenderOptions {
   RenderParams params{};
   Backend backend = Backend::Cpu;
   Kernel kernel = Kernel::Megakernel;
   int warmup = 0;         // untimed renders before the timed one, on every backend
   int64_t wave_size = 0;  // wavefront path slots; 0 chooses (queues/wave.hpp)
-  int fetch_min_busy = kDefaultFetchMinBusy;  // 0: the CUDA intersect runs a thread a ray
   int threads = 0;        // CPU threads; 0 uses every core
   // The devices to split the render over (render/split.hpp): CUDA device indices,
   // or on the CPU backend host "devices" (each a share of the threads). None or

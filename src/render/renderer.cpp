@@ -27,7 +27,6 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
   const RenderParams& p = options.params;
   validate_params(p);
   if (options.wave_size != 0) check_setting(SettingId::WaveSize, options.wave_size);
-  check_setting(SettingId::FetchMinBusy, options.fetch_min_busy);
   if (options.first_sample < 0 || options.first_sample >= p.spp || options.sample_count < 0 ||
       options.sample_count > p.spp - options.first_sample) {
     throw SceneError("samples: " + std::to_string(options.first_sample) + " + " +

@@ -21,9 +21,6 @@ const std::vector<Setting>& settings() {
       {SettingId::Warmup, "warmup", "--warmup", SettingType::Int32, 0, 100, 0, "untimed renders before the timed one"},
       {SettingId::WaveSize, "wave_size", "--wave-size", SettingType::Int64, kMinWaveSlots,
        static_cast<int64_t>(kMaxWaveSize), 0, "wavefront path slots (default: chosen from free memory)"},
-      {SettingId::FetchMinBusy, "fetch_min_busy", "--fetch-min-busy", SettingType::Int32, 0, 32, kDefaultFetchMinBusy,
-       "CUDA wavefront, scenes with triangles: a warp's lanes that are done take new rays once fewer than this many "
-       "of its 32 still trace (0: a thread a ray)"},
       {SettingId::Threads, "threads", "--threads", SettingType::Int32, 1, 1024, 0, "CPU threads (default: all cores)"},
       {SettingId::CheckpointEvery, "checkpoint_every", "--checkpoint-every", SettingType::Int32, 1, 30 * 24 * 3600,
        300, "seconds between checkpoints (with --checkpoint)"},

@@ -12,7 +12,7 @@
 
 namespace wt {
 
-enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Nee, Warmup, WaveSize, FetchMinBusy, Threads, CheckpointEvery };
+enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Nee, Warmup, WaveSize, Threads, CheckpointEvery };
 
 enum class SettingType { Int32, UInt32, Int64 };
 

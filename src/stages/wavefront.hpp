@@ -137,7 +137,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         with_kinds<false>(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
                     IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, limit, first,
-                                           slots, film, options.fetch_min_busy});
+                                           slots, film});
         });
         ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, limit, slots});
         ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,

@@ -80,133 +80,92 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
   }
 }
 
-// A traversal never suspended: intersect_closest's.
-struct NeverYield {
-  WT_HD constexpr bool operator()() const { return false; }
-};
-
-// The walk for the closest hit along `world` before tmax, as state that can be
-// suspended between two steps and resumed (the GPU's fetching intersect,
-// cuda/executor.cuh) or run to its end at once (intersect_closest). The top-level
-// BVH's leaves are single instances; entering one moves the ray into the instance's
-// object space (where t measures the same distances: the direction is transformed,
-// not renormalised) and pushes the mark of the way back. The stack lives beside the
-// state, in arrays of kStack entries that the caller keeps: inside the struct they
-// would drag the whole state into local memory.
+// The closest hit along `world` before tmax. The top-level BVH's leaves are single
+// instances; entering one moves the ray into the instance's object space (where t
+// measures the same distances: the direction is transformed, not renormalised) and
+// pushes the mark of the way back.
 //
-// AnyHit: stop at the first hit found (not the closest): enough to know that the
+// AnyHit: return the first hit found (not the closest): enough to know that the
 // segment to tmax is blocked, which is what a shadow ray asks.
-template <uint32_t Kinds = kAllKinds, bool AnyHit = false>
-struct Traversal {
-  // Only triangle instances are ever transformed (spheres stand untransformed), and
-  // only triangles need the slab test's round-up (spheres' boxes are padded).
-  static constexpr bool kTriangles = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
-  // Spheres alone stand in one instance: the top level is a single leaf, and the
-  // stack holds the return mark and one tree's deferred nodes.
-  static constexpr int kStack = kTriangles ? kBvhStackSize : kMaxBvhDepth + 1;
-
-  Ray world;
-  Ray ray;
-  vec3 inv;
-  TriangleRay tr;
-  int instance;
-  PrimitiveKind kind;
-  int top;
-  // The node in hand: its record came with its sibling's when their parent was
-  // visited, so a step down costs one fetch (the two children), not two.
-  BvhNode n;
-  Hit hit;
-
-  // Begins the walk; false where there is nothing to walk (hit is then the miss).
-  template <class Geometry>
-  WT_HD WT_INLINE bool start(const Geometry& g, const Ray& w, float tmax) {
-    hit = Hit{tmax, -1, -1, 0.0f, 0.0f};
-    world = w;
-    if (g.node_count() == 0) return false;
-    ray = w;
-    inv = slab_inverse(w.dir);
-    tr = TriangleRay{};
-    instance = -1;
-    kind = PrimitiveKind::Sphere;
-    top = 0;
-    n = g.node(0);
-    return true;
-  }
-
-  // Walks until the walk ends (true: hit holds the answer) or, between two steps,
-  // yield() says to stop (false: call again to go on).
-  template <class Geometry, class Yield>
-  WT_HD WT_INLINE bool resume(const Geometry& g, int* stack, float* stack_t, Yield&& yield) {
-    for (;;) {
-      if (yield()) return false;
-      if (n.count > 0 && instance < 0) {
-        instance = n.left_or_first;
-        const Instance& in = g.instance(instance);
-        kind = in.kind;
-        if (kTriangles && !in.identity) {
-          ray.origin = in.object_from_world.point(world.origin);
-          ray.dir = in.object_from_world.vector(world.dir);
-          inv = slab_inverse(ray.dir);
-        }
-        if (kTriangles && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
-        if (top < kStack) {
-          stack[top] = kReturnToWorld;
-          stack_t[top++] = 0.0f;
-        }
-        n = g.node(in.root);
-        continue;
-      }
-      if (n.count > 0) {
-        intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
-        if (AnyHit && hit.prim >= 0) return true;
-      } else {
-        const int a = n.left_or_first;
-        const BvhNode na = g.node(a), nb = g.node(a + 1);
-        const float ta = box_entry<kTriangles>(na, ray.origin, inv, hit.t);
-        const float tb = box_entry<kTriangles>(nb, ray.origin, inv, hit.t);
-        const bool a_first = ta <= tb;
-        const float t_near = a_first ? ta : tb, t_far = a_first ? tb : ta;
-        if (t_near <= hit.t) {
-          if (t_far <= hit.t && top < kStack) {
-            stack[top] = a_first ? a + 1 : a;
-            stack_t[top++] = t_far;
-          }
-          n = a_first ? na : nb;
-          continue;
-        }
-      }
-      // Pop, skipping nodes whose boxes the closest hit so far already passed.
-      bool found = false;
-      while (top > 0) {
-        --top;
-        if (stack[top] == kReturnToWorld) {
-          if (kTriangles) {
-            ray = world;
-            inv = slab_inverse(world.dir);
-          }
-          instance = -1;
-          continue;
-        }
-        if (stack_t[top] <= hit.t) {
-          n = g.node(stack[top]);
-          found = true;
-          break;
-        }
-      }
-      if (!found) return true;
-    }
-  }
-};
-
-// The closest hit along `world` before tmax (or with AnyHit, the first found).
 template <uint32_t Kinds = kAllKinds, bool AnyHit = false, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
-  using Walk = Traversal<Kinds, AnyHit>;
-  Walk walk;
-  int stack[Walk::kStack];
-  float stack_t[Walk::kStack];
-  if (walk.start(g, world, tmax)) walk.resume(g, stack, stack_t, NeverYield{});
-  return walk.hit;
+  Hit hit{tmax, -1, -1, 0.0f, 0.0f};
+  if (g.node_count() == 0) return hit;
+  // Only triangle instances are ever transformed (spheres stand untransformed), and
+  // only triangles need the slab test's round-up (spheres' boxes are padded).
+  constexpr bool kTriangles = (Kinds & kind_bit(PrimitiveKind::Triangle)) != 0;
+  Ray ray = world;
+  vec3 inv = slab_inverse(world.dir);
+  TriangleRay tr{};
+  int instance = -1;
+  PrimitiveKind kind = PrimitiveKind::Sphere;
+  // Spheres alone stand in one instance: the top level is a single leaf, and the
+  // stack holds the return mark and one tree's deferred nodes.
+  constexpr int kStack = kTriangles ? kBvhStackSize : kMaxBvhDepth + 1;
+  int stack[kStack];
+  float stack_t[kStack];
+  int top = 0;
+  // The node in hand: its record came with its sibling's when their parent was
+  // visited, so a step down costs one fetch (the two children), not two.
+  BvhNode n = g.node(0);
+  for (;;) {
+    if (n.count > 0 && instance < 0) {
+      instance = n.left_or_first;
+      const Instance& in = g.instance(instance);
+      kind = in.kind;
+      if (kTriangles && !in.identity) {
+        ray.origin = in.object_from_world.point(world.origin);
+        ray.dir = in.object_from_world.vector(world.dir);
+        inv = slab_inverse(ray.dir);
+      }
+      if (kTriangles && kind == PrimitiveKind::Triangle) tr = triangle_ray(ray.dir);
+      if (top < kStack) {
+        stack[top] = kReturnToWorld;
+        stack_t[top++] = 0.0f;
+      }
+      n = g.node(in.root);
+      continue;
+    }
+    if (n.count > 0) {
+      intersect_leaf<Kinds>(g, kind, instance, n.left_or_first, n.count, ray, tr, hit);
+      if (AnyHit && hit.prim >= 0) return hit;
+    } else {
+      const int a = n.left_or_first;
+      const BvhNode na = g.node(a), nb = g.node(a + 1);
+      const float ta = box_entry<kTriangles>(na, ray.origin, inv, hit.t);
+      const float tb = box_entry<kTriangles>(nb, ray.origin, inv, hit.t);
+      const bool a_first = ta <= tb;
+      const float t_near = a_first ? ta : tb, t_far = a_first ? tb : ta;
+      if (t_near <= hit.t) {
+        if (t_far <= hit.t && top < kStack) {
+          stack[top] = a_first ? a + 1 : a;
+          stack_t[top++] = t_far;
+        }
+        n = a_first ? na : nb;
+        continue;
+      }
+    }
+    // Pop, skipping nodes whose boxes the closest hit so far already passed.
+    bool found = false;
+    while (top > 0) {
+      --top;
+      if (stack[top] == kReturnToWorld) {
+        if (kTriangles) {
+          ray = world;
+          inv = slab_inverse(world.dir);
+        }
+        instance = -1;
+        continue;
+      }
+      if (stack_t[top] <= hit.t) {
+        n = g.node(stack[top]);
+        found = true;
+        break;
+      }
+    }
+    if (!found) break;
+  }
+  return hit;
 }
 
 // The material a hit shades with: the instance's override, or the primitive's own.
