@@ -280,12 +280,14 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
   };
 
   for (size_t d = 0; d < devices; ++d) threads.emplace_back(work, d);
-  // Waits until every device has ended, then lets them free their memory.
+  // Waits until every device has ended (each still holds its memory, sums and all).
+  auto wait_for_devices = [&] {
+    std::unique_lock<std::mutex> lock(m);
+    chunk_cv.wait(lock, [&] { return working == 0; });
+  };
+  // The same, then lets them free their memory: the way out of a failed render.
   auto wind_down = [&] {
-    {
-      std::unique_lock<std::mutex> lock(m);
-      chunk_cv.wait(lock, [&] { return working == 0; });
-    }
+    wait_for_devices();
     release_devices();
   };
   try {
@@ -351,16 +353,13 @@ inline RenderResult render_split(const RenderOptions& options, const std::vector
     wind_down();
     split_detail::rethrow_naming(error, failed_device);
   }
-  {
-    std::unique_lock<std::mutex> lock(m);
-    chunk_cv.wait(lock, [&] { return working == 0; });
-  }
+  wait_for_devices();
   // In device order, onto zeros (the first device's sums are then the film itself:
   // x + 0 is x) or onto the resumed film.
   if (keep) split_detail::add_in_order(out.rgb, sums_of);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   release_devices();
-  if (fed && !error) {
+  if (fed) {
     // Every path was traced (a device that fails throws above): the whole render.
     folded = chunks.size();
     out.samples = chunks.empty() ? options.first_sample : chunks.back().first + chunks.back().count;
