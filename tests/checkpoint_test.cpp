@@ -115,7 +115,7 @@ TEST_F(CheckpointTest, ADamagedOrCutOrForeignFileIsRefused) {
                                              std::to_string(version) + "; this wavetrace reads version " +
                                              std::to_string(kCheckpointFormat));
 
-  EXPECT_EQ(refusal(path("missing.ckpt")), path("missing.ckpt") + ": cannot open checkpoint");
+  EXPECT_EQ(refusal(path("missing.ckpt")), path("missing.ckpt") + ": cannot open checkpoint (No such file or directory)");
 }
 
 TEST_F(CheckpointTest, AnotherSceneSettingsOrKernelIsRefused) {

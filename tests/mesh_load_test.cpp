@@ -195,12 +195,13 @@ TEST_F(MeshLoad, ObjDropsAndCountsDegenerateTriangles) {
 TEST_F(MeshLoad, ObjErrorsNameTheFileAndTheProblem) {
   expect_error((folder_.root() / "missing.obj").string(), "cannot open mesh file (No such file or directory)");
   expect_error(write("mesh.ply", "ply\n"), "unknown mesh format '.ply' (expected .obj, .gltf, .glb)");
-  expect_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "malformed OBJ: ");
+  expect_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "malformed OBJ: line 4: ");
   expect_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of");
   expect_error(write("empty.obj", "# nothing\nv 0 0 0\n"), "has no triangles");
   expect_error(write("flat.obj", "v 0 0 0\nv 1 0 0\nf 1 2 2\n"), "no triangles left (1 degenerate and 0 non-finite dropped)");
   expect_error(write("nomtl.obj", "mtllib absent.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
-               "malformed OBJ: Material file [ absent.mtl ] not found");
+               "mtllib absent.mtl: " + (folder_.root() / "absent.mtl").string() +
+                   ": cannot open material library (No such file or directory)");
   write("one.mtl", "newmtl known\nKd 1 1 1\n");
   expect_error(write("unknown.obj", "mtllib one.mtl\nusemtl nosuch\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
                "malformed OBJ: material [ 'nosuch' ] not found in .mtl");

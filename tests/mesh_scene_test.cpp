@@ -85,13 +85,14 @@ TEST_F(MeshScene, UnreadableMeshFileNamesTheFile) {
 TEST_F(MeshScene, MalformedObjNamesTheFile) {
   std::ofstream(path("bad.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";  // a corner that does not exist
   const std::string scene = write_scene(R"([{"name": "a", "file": "bad.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, scene + ": /meshes/0/file: " + path("bad.obj"), {"malformed OBJ", "out of bounds", "line 4"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("bad.obj"), {"malformed OBJ: line 4: index 7 is out of range: the file has 3 vertex positions"});
 }
 
 TEST_F(MeshScene, ObjWithAMissingMtlNamesTheFile) {
   std::ofstream(path("mtl.obj")) << "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n";
   const std::string scene = write_scene(R"([{"name": "a", "file": "mtl.obj"}])", R"([{"mesh": "a"}])");
-  expect_error(scene, scene + ": /meshes/0/file: " + path("mtl.obj"), {"malformed OBJ"});
+  expect_error(scene, scene + ": /meshes/0/file: " + path("mtl.obj"),
+               {"mtllib nowhere.mtl: " + path("nowhere.mtl") + ": cannot open material library"});
 }
 
 TEST_F(MeshScene, UnknownMeshInAnInstance) {

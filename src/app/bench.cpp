@@ -22,7 +22,7 @@ namespace wt::app {
 namespace fs = std::filesystem;
 
 BenchSpec read_bench_spec(const std::string& path, const std::string& only) {
-  const json doc = read_json_file(path, "bench spec");
+  const json doc = read_json_file(path, input::kBenchSpec);
   const JsonReader r(path);
   const JsonPath top;
   r.check_keys(doc, top, {"warmup", "repeats", "check_spp", "check_bound", "groups"});

@@ -2,14 +2,14 @@
 
 #include <zlib.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "image/image_io.hpp"
 #include "render/settings.hpp"
-#include "scene/scene.hpp"
+#include "scene/input_file.hpp"
 
 namespace wt::app {
 
@@ -46,13 +46,25 @@ json identity_json(const CheckpointIdentity& id) {
   throw SceneError(path + ": not a usable checkpoint: " + what);
 }
 
+// A header's count: a JSON integer (not 2.5, not "2") in lo..hi.
+int64_t whole_number(const std::string& path, const json& value, const std::string& key, int64_t lo, int64_t hi) {
+  if (!value.is_number_integer()) {
+    damaged(path, "its " + key + " is " + value.dump() + ", not a whole number");
+  }
+  const bool negative = value.is_number_unsigned() ? false : value.get<int64_t>() < 0;
+  const int64_t v = negative ? value.get<int64_t>()
+                             : static_cast<int64_t>(std::min<uint64_t>(value.get<uint64_t>(), uint64_t{INT64_MAX}));
+  if (v < lo || v > hi) {
+    damaged(path, "its " + key + " is " + value.dump() + ", outside " + std::to_string(lo) + ".." + std::to_string(hi));
+  }
+  return v;
+}
+
 }  // namespace
 
 CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
                                        const std::string& kernel, const std::string& backend) {
-  std::ifstream f(scene, std::ios::binary);
-  if (!f) throw SceneError(scene + ": cannot open scene file");
-  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const std::string bytes = read_input_file(scene, input::kScene);
   CheckpointIdentity id;
   id.scene = scene;
   id.scene_crc = crc_of(bytes.data(), bytes.size());
@@ -79,9 +91,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw SceneError(path + ": cannot open checkpoint");
-  const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  const std::string bytes = read_input_file(path, input::kCheckpoint);
   const size_t fixed = sizeof kMagic + 2 * sizeof(uint32_t);
   if (bytes.size() < fixed + sizeof(uint64_t) + sizeof(uint32_t) ||
       std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
@@ -105,22 +115,42 @@ Checkpoint read_checkpoint(const std::string& path) {
     const json header = json::parse(bytes.substr(fixed, header_bytes));
     c.identity.scene = header.at("scene").get<std::string>();
     c.identity.scene_crc = header.at("scene_crc32").get<uint32_t>();
-    for (SettingId s : render_settings()) set_param(c.identity.params, s, header.at("settings").at(setting(s).key).get<int64_t>());
+    for (SettingId s : render_settings()) {
+      const Setting& info = setting(s);
+      set_param(c.identity.params, s, whole_number(path, header.at("settings").at(info.key), info.key, info.lo, info.hi));
+    }
     c.identity.kernel = header.at("kernel").get<std::string>();
     c.identity.backend = header.at("backend").get<std::string>();
     c.identity.renderer = header.at("renderer").get<std::string>();
-    c.samples = header.at("samples").get<int32_t>();
+    c.samples = static_cast<int32_t>(whole_number(path, header.at("samples"), "samples", 0, c.identity.params.spp));
   } catch (const nlohmann::json::exception& e) {
     damaged(path, std::string("its header cannot be read (") + e.what() + ")");
   }
   uint64_t floats = 0;
   const size_t at = fixed + header_bytes;
   std::memcpy(&floats, bytes.data() + at, sizeof floats);
+  const uint64_t expected = uint64_t{3} * static_cast<uint64_t>(c.identity.params.width) *
+                            static_cast<uint64_t>(c.identity.params.height);
+  if (floats != expected) {
+    damaged(path, "its film holds " + std::to_string(floats) + " values; a " + std::to_string(c.identity.params.width) +
+                      " x " + std::to_string(c.identity.params.height) + " render's holds " + std::to_string(expected));
+  }
   if (at + sizeof floats + floats * sizeof(float) + sizeof(uint32_t) != bytes.size()) {
     damaged(path, "its film is not the size its header says");
   }
   c.film.resize(floats);
   std::memcpy(c.film.data(), bytes.data() + at + sizeof floats, floats * sizeof(float));
+  // Radiance is never negative, so neither is a sum of samples of it.
+  for (size_t i = 0; i < c.film.size(); ++i) {
+    const float v = c.film[i];
+    if (!std::isfinite(v) || v < 0.0f) {
+      const size_t pixel = i / 3;
+      const size_t w = static_cast<size_t>(c.identity.params.width);
+      damaged(path, "its film's pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) + ") holds " +
+                        (std::isnan(v) ? std::string("NaN") : std::isinf(v) ? "an infinity" : std::to_string(v)) +
+                        "; a sum of radiance is finite and at least 0");
+    }
+  }
   return c;
 }
 

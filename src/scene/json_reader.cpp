@@ -1,10 +1,9 @@
 #include "scene/json_reader.hpp"
 
 #include <algorithm>
-#include <cerrno>
+#include <deque>
 #include <cfloat>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <utility>
 
@@ -31,7 +30,8 @@ void append_token(std::string& out, std::string_view key) {
 // array of objects, such as a scene's spheres.
 class DomBuilder : public nlohmann::json_sax<json> {
  public:
-  explicit DomBuilder(const std::string& source) : source_(source) {}
+  DomBuilder(const std::string& source, std::vector<std::string>* duplicates)
+      : source_(source), duplicates_(duplicates) {}
 
   json take() { return std::move(root_); }
 
@@ -54,7 +54,11 @@ class DomBuilder : public nlohmann::json_sax<json> {
       std::string path = path_of_open_containers();
       path += '/';
       append_token(path, k);  // not moved from: try_emplace inserted nothing
-      throw SceneError(source_ + ": " + path + ": duplicate key");
+      if (!duplicates_) throw SceneError(source_ + ": " + path + ": duplicate key");
+      // Recorded, and the repeated value read into a place of its own and dropped.
+      duplicates_->push_back(std::move(path));
+      member_ = &dropped_.emplace_back();
+      return true;
     }
     member_ = &it->second;
     return true;
@@ -123,6 +127,8 @@ class DomBuilder : public nlohmann::json_sax<json> {
   }
 
   const std::string& source_;
+  std::vector<std::string>* duplicates_;
+  std::deque<json> dropped_;  // the values of repeated keys (a deque: their addresses stay put)
   json root_;
   std::vector<json*> stack_;  // the open containers, outermost first
   json* member_ = nullptr;    // where the next value of the innermost object goes
@@ -147,27 +153,15 @@ void JsonPath::append(std::string& out) const {
   }
 }
 
-json parse_json(const std::string& text, const std::string& source) {
-  DomBuilder builder(source);
+json parse_json(const std::string& text, const std::string& source, std::vector<std::string>* duplicates) {
+  DomBuilder builder(source, duplicates);
   json::sax_parse(text, &builder);
   return builder.take();
 }
 
-std::string read_file(const std::string& path, const char* what) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) throw SceneError(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
-  std::string text;
-  char buf[1 << 16];
-  size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  bool failed = std::ferror(f) != 0;
-  int err = errno;
-  std::fclose(f);
-  if (failed) throw SceneError(path + ": cannot read " + what + " (" + std::strerror(err) + ")");
-  return text;
+json read_json_file(const std::string& path, const InputKind& kind) {
+  return parse_json(read_input_file(path, kind), path);
 }
-
-json read_json_file(const std::string& path, const char* what) { return parse_json(read_file(path, what), path); }
 
 std::string listed(const std::vector<std::string>& names) {
   std::string out;

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "scene/input_file.hpp"
 #include "scene/scene.hpp"
 
 namespace wt {
@@ -38,15 +39,13 @@ class JsonPath {
 // Parses JSON text, rejecting a key repeated in one object (nlohmann would keep the
 // last value without a word). Time and memory are linear in the text. Throws
 // SceneError "<source>: malformed JSON: ..." or "<source>: /path: duplicate key".
-json parse_json(const std::string& text, const std::string& source);
+// With `duplicates`, a repeated key is not thrown but its JSON pointer recorded there,
+// the first value kept (a jobs file fails the one job that holds it).
+json parse_json(const std::string& text, const std::string& source, std::vector<std::string>* duplicates = nullptr);
 
-// Reads a whole file; `what` names the kind of file in the message when it cannot
-// be opened or read: SceneError "<path>: cannot open <what> (<reason>)".
-std::string read_file(const std::string& path, const char* what);
-
-// Reads a whole file and parses it as above; `what` names the kind of file in the
-// message when it cannot be read ("scene file", "jobs file", ...).
-json read_json_file(const std::string& path, const char* what);
+// Reads a whole input file (read_input_file: a regular file within its kind's limit)
+// and parses it as above.
+json read_json_file(const std::string& path, const InputKind& kind);
 
 // The typed field readers: each checks one value and throws SceneError
 // "<source>: <path>: <what is wrong>".

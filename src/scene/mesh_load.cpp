@@ -3,7 +3,11 @@
 // drops degenerate triangles and maps materials (docs/scene-format.md, "Meshes").
 #include "scene/mesh_load.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -13,9 +17,12 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
+#include <map>
 #include <sstream>
+#include <string_view>
 #include <unordered_map>
 
+#include "scene/input_file.hpp"
 #include "scene/json_reader.hpp"
 #include "scene/mesh_libraries.hpp"
 #include "scene/scene.hpp"
@@ -118,9 +125,9 @@ uint32_t default_material(TriangleMesh& mesh, int64_t& index, const std::functio
 vec3 checked_colour(const std::string& path, const std::string& material, const char* field, const double* c,
                     bool radiance) {
   for (int i = 0; i < 3; ++i) {
-    if (!std::isfinite(c[i]) || c[i] < 0.0 || (!radiance && c[i] > 1.0) || c[i] > std::numeric_limits<float>::max()) {
+    if (!std::isfinite(c[i]) || c[i] < 0.0 || c[i] > (radiance ? kMaxRadiance : 1.0)) {
       fail(path, "material '" + material + "': " + field + " must be 3 numbers " +
-                     (radiance ? "no less than 0" : "in [0, 1]"));
+                     (radiance ? "in [0, 1e9] (the most radiance a scene may hold)" : "in [0, 1]"));
     }
   }
   return vec3(static_cast<float>(c[0]), static_cast<float>(c[1]), static_cast<float>(c[2]));
@@ -191,16 +198,138 @@ struct CornerHash {
   }
 };
 
+// MTL files for tinyobjloader, read as every input file is (read_input_file). The
+// first that cannot be read is kept, and reported as the mesh's error.
+class MaterialLibraries : public tinyobj::MaterialReader {
+ public:
+  explicit MaterialLibraries(fs::path dir) : dir_(std::move(dir)) {}
+
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* names, std::string* warn, std::string* err) override {
+    const std::string file = (dir_ / name).lexically_normal().string();
+    std::string text;
+    try {
+      text = read_input_file(file, input::kMaterialLibrary);
+    } catch (const SceneError& e) {
+      if (error_.empty()) error_ = std::string("mtllib ") + name + ": " + e.what();
+      if (err) *err += error_ + "\n";
+      return false;
+    }
+    std::istringstream in(text);
+    tinyobj::LoadMtl(names, materials, &in, warn, err);
+    return true;
+  }
+
+  const std::string& error() const { return error_; }
+
+ private:
+  fs::path dir_;
+  std::string error_;
+};
+
+// tinyobjloader reads a number it cannot parse (`v abc 0 0`) as 0, keeps NaN and the
+// infinities, and wraps an index past 2^31 to another vertex's. The text is checked
+// before it parses it: every number of a v, vt or vn line finite and in float range,
+// every index of an f, l or p line a whole number that names an element of the file.
+// An error names the line.
+void check_obj_numbers(const std::string& text, const std::string& path) {
+  enum { kV, kVt, kVn };
+  size_t count[3] = {0, 0, 0};
+  int64_t largest[3] = {0, 0, 0};  // the largest index given, and its line
+  size_t largest_line[3] = {0, 0, 0};
+  static const char* const kKinds[3] = {"vertex position", "texture coordinate", "normal"};
+  const auto line_error = [&](size_t line, const std::string& what) {
+    fail(path, "malformed OBJ: line " + std::to_string(line) + ": " + what);
+  };
+  size_t at = 0, line = 0;
+  std::vector<std::string_view> words;
+  while (at < text.size()) {
+    const size_t end = std::min(text.find('\n', at), text.size());
+    std::string_view rest(text.data() + at, end - at);
+    at = end + 1;
+    ++line;
+    rest = rest.substr(0, rest.find('#'));
+    words.clear();
+    for (size_t i = 0; i < rest.size();) {
+      const size_t begin = rest.find_first_not_of(" \t\r\v\f", i);
+      if (begin == std::string_view::npos) break;
+      const size_t stop = std::min(rest.find_first_of(" \t\r\v\f", begin), rest.size());
+      words.push_back(rest.substr(begin, stop - begin));
+      i = stop;
+    }
+    if (words.empty()) continue;
+    const std::string_view command = words[0];
+    const int kind = command == "v" ? kV : command == "vt" ? kVt : command == "vn" ? kVn : -1;
+    if (kind >= 0) {
+      // v: x y z, then w or r g b (and w); vt: u, v, w; vn: x y z.
+      const size_t lo = kind == kVt ? 1 : 3, hi = kind == kV ? 7 : 3;
+      const size_t n = words.size() - 1;
+      if (n < lo || n > hi) {
+        line_error(line, std::string(command) + " needs " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + " to " +
+                                                                                     std::to_string(hi)) +
+                             " numbers (got " + std::to_string(n) + ")");
+      }
+      for (size_t w = 1; w < words.size(); ++w) {
+        const std::string word(words[w]);
+        char* stop = nullptr;
+        const double v = std::strtod(word.c_str(), &stop);
+        if (stop != word.c_str() + word.size() || !std::isfinite(v) ||
+            std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max())) {
+          line_error(line, std::string(command) + ": '" + word + "' is not a finite number");
+        }
+      }
+      ++count[kind];
+    } else if (command == "f" || command == "l" || command == "p") {
+      for (size_t w = 1; w < words.size(); ++w) {
+        const std::string_view corner = words[w];
+        size_t field_begin = 0;
+        for (int field = 0; field < 3 && field_begin <= corner.size(); ++field) {
+          const size_t slash = std::min(corner.find('/', field_begin), corner.size());
+          const std::string word(corner.substr(field_begin, slash - field_begin));
+          field_begin = slash + 1;
+          if (word.empty() && field > 0) continue;  // v//vn, v/vt/
+          const int k = field == 0 ? kV : field == 1 ? kVt : kVn;
+          errno = 0;
+          char* stop = nullptr;
+          const long long v = word.empty() ? 0 : std::strtoll(word.c_str(), &stop, 10);
+          if (word.empty() || stop != word.c_str() + word.size() || errno == ERANGE || v == 0) {
+            line_error(line, std::string(command) + ": '" + std::string(corner) + "' is not a corner of whole, non-zero indices");
+          }
+          if (v < 0 && static_cast<unsigned long long>(-(v + 1)) >= count[k]) {
+            line_error(line, std::string(command) + ": index " + word + " reaches before the first " + kKinds[k] +
+                                 " (" + std::to_string(count[k]) + " given so far)");
+          }
+          if (v > largest[k]) {
+            largest[k] = v;
+            largest_line[k] = line;
+          }
+        }
+        if (field_begin <= corner.size()) {
+          line_error(line, std::string(command) + ": '" + std::string(corner) + "' has more than three indices");
+        }
+      }
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (static_cast<uint64_t>(largest[k]) > count[k]) {
+      line_error(largest_line[k], "index " + std::to_string(largest[k]) + " is out of range: the file has " +
+                                      std::to_string(count[k]) + " " + kKinds[k] + (count[k] == 1 ? "" : "s"));
+    }
+  }
+}
+
 void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) {
   const std::string& path = mesh.source;
+  check_obj_numbers(text, path);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
   std::string warn, err;
   std::istringstream in(text);
-  tinyobj::MaterialFileReader mtl(dir.empty() ? std::string() : dir.string() + "/");
+  MaterialLibraries mtl(dir);
   bool ok = tinyobj::LoadObj(&attrib, &shapes, &materials, &warn, &err, &in, &mtl, /*triangulate=*/true,
                              /*default_vcols_fallback=*/false);
+  if (!mtl.error().empty()) fail(path, mtl.error());
   if (!ok || !err.empty()) fail(path, "malformed OBJ: " + first_line(err.empty() ? warn : err));
   // tinyobjloader reports a missing MTL file, an unknown material name and indices
   // out of range as warnings and goes on; here they are errors. A face of fewer than
@@ -428,21 +557,76 @@ class GltfReader {
     } else {
       int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
       if (static_cast<size_t>(s) >= scenes.size()) fail(mesh_.source, "default scene index out of range");
-      for (int node : scenes[s].nodes) visit(node, glm::dmat4(1.0), 0);
+      check_forest(scenes[s].nodes);
+      walk(scenes[s].nodes);
     }
     builder_.finish();
   }
 
  private:
-  void visit(int index, const glm::dmat4& parent, size_t depth) {
-    if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size()) {
-      fail(mesh_.source, "node index " + std::to_string(index) + " out of range");
+  // Checks that the nodes form a forest, as the specification requires: no node with
+  // two parents (or listed twice by one), no cycle, and the scene's nodes roots, each
+  // listed once. A node is then reached once from its scene: the walk is linear in
+  // the nodes, whatever the graph.
+  void check_forest(const std::vector<int>& roots) const {
+    const std::string& path = mesh_.source;
+    const size_t n = model_.nodes.size();
+    std::vector<int64_t> parent(n, -1);
+    for (size_t i = 0; i < n; ++i) {
+      for (int child : model_.nodes[i].children) {
+        if (child < 0 || static_cast<size_t>(child) >= n) {
+          fail(path, "node " + std::to_string(i) + ": child index " + std::to_string(child) + " out of range");
+        }
+        if (parent[child] >= 0) {
+          fail(path, "node " + std::to_string(child) + " has two parents (nodes " + std::to_string(parent[child]) +
+                         " and " + std::to_string(i) + "); glTF nodes form a forest, each node with one parent at most");
+        }
+        parent[child] = static_cast<int64_t>(i);
+      }
     }
-    if (depth > model_.nodes.size()) fail(mesh_.source, "the node hierarchy has a cycle");
-    const tinygltf::Node& node = model_.nodes[index];
-    glm::dmat4 world = parent * local_transform(node, mesh_.source);
-    if (node.mesh >= 0) read_mesh(node.mesh, world);
-    for (int child : node.children) visit(child, world, depth + 1);
+    // Following the parents from every node: a root ends every chain, or there is a cycle.
+    std::vector<char> state(n, 0);  // 0: unseen, 1: on the chain being followed, 2: reaches a root
+    std::vector<size_t> chain;
+    for (size_t start = 0; start < n; ++start) {
+      chain.clear();
+      int64_t at = static_cast<int64_t>(start);
+      while (at >= 0 && state[at] == 0) {
+        state[at] = 1;
+        chain.push_back(static_cast<size_t>(at));
+        at = parent[at];
+      }
+      if (at >= 0 && state[at] == 1) fail(path, "the node hierarchy has a cycle through node " + std::to_string(at));
+      for (size_t c : chain) state[c] = 2;
+    }
+    std::vector<char> listed(n, 0);
+    for (int root : roots) {
+      if (root < 0 || static_cast<size_t>(root) >= n) fail(path, "node index " + std::to_string(root) + " out of range");
+      if (parent[root] >= 0) {
+        fail(path, "node " + std::to_string(root) + " is a root of the scene but a child of node " +
+                       std::to_string(parent[root]));
+      }
+      if (listed[root]) fail(path, "node " + std::to_string(root) + " is listed twice among the scene's nodes");
+      listed[root] = 1;
+    }
+  }
+
+  // Every node under `roots`, depth first in the file's order (a node, then its
+  // children), on a stack of its own rather than the call stack.
+  void walk(const std::vector<int>& roots) {
+    struct Visit {
+      int node;
+      glm::dmat4 parent;
+    };
+    std::vector<Visit> stack;
+    for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, glm::dmat4(1.0)});
+    while (!stack.empty()) {
+      const Visit v = stack.back();
+      stack.pop_back();
+      const tinygltf::Node& node = model_.nodes[v.node];
+      const glm::dmat4 world = v.parent * local_transform(node, mesh_.source);
+      if (node.mesh >= 0) read_mesh(node.mesh, world);
+      for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+    }
   }
 
   void read_mesh(int index, const glm::dmat4& world) {
@@ -479,8 +663,13 @@ class GltfReader {
         material = static_cast<uint32_t>(prim.material);
       } else {
         material = default_material(mesh_, default_, [&] {
-          tinygltf::Material g;  // glTF's default material
+          // The specification's default material: every property at its default.
+          tinygltf::Material g;
           g.name = "default";
+          g.emissiveFactor = {0.0, 0.0, 0.0};
+          g.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+          g.pbrMetallicRoughness.metallicFactor = 1.0;
+          g.pbrMetallicRoughness.roughnessFactor = 1.0;
           return map_gltf(model_, g, 0, fs::path(), path);
         });
       }
@@ -534,10 +723,40 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
   return true;
 }
 
+// A glTF file's buffers, read as every input file is (read_input_file); the first
+// that cannot be read is kept, and reported as the mesh's error.
+struct GltfFiles {
+  std::string error;
+
+  static bool exists(const std::string& path, void*) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0;  // whatever it is: reading it says what is wrong
+  }
+  static std::string expand(const std::string& path, void*) { return path; }
+  static bool read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    auto& files = *static_cast<GltfFiles*>(user);
+    try {
+      const std::string bytes = read_input_file(path, input::kGltfBuffer);
+      out->assign(bytes.begin(), bytes.end());
+      return true;
+    } catch (const SceneError& e) {
+      if (files.error.empty()) files.error = e.what();
+      if (err) *err += std::string(e.what()) + "\n";
+      return false;
+    }
+  }
+  static bool write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "wavetrace writes no glTF files\n";
+    return false;
+  }
+};
+
 void load_gltf(const std::string& bytes, bool binary, const fs::path& dir, TriangleMesh& mesh) {
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) fail(mesh.source, "file too large for tinygltf");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(skip_image, nullptr);
+  GltfFiles files;
+  loader.SetFsCallbacks({&GltfFiles::exists, &GltfFiles::expand, &GltfFiles::read, &GltfFiles::write, &files});
   tinygltf::Model model;
   std::string err, warn;
   const unsigned int size = static_cast<unsigned int>(bytes.size());
@@ -545,6 +764,7 @@ void load_gltf(const std::string& bytes, bool binary, const fs::path& dir, Trian
                                                  reinterpret_cast<const unsigned char*>(bytes.data()), size,
                                                  dir.string())
                    : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, dir.string());
+  if (!files.error.empty()) fail(mesh.source, files.error);
   if (!ok || !err.empty()) fail(mesh.source, "malformed glTF: " + first_line(err.empty() ? warn : err));
   GltfReader(model, dir, mesh).read();
 }
@@ -557,7 +777,7 @@ TriangleMesh load_mesh(const std::string& path) {
   if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
     fail(path, "unknown mesh format '" + ext + "' (expected .obj, .gltf, .glb)");
   }
-  const std::string bytes = read_file(path, "mesh file");
+  const std::string bytes = read_input_file(path, input::kMesh);
   const fs::path dir = fs::path(path).parent_path();
   TriangleMesh mesh;
   mesh.source = path;

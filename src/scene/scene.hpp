@@ -29,6 +29,15 @@ constexpr int kMaxImageSide = 16384;
 constexpr int kMaxSpp = 1000000;
 constexpr int kMaxPathDepth = 1024;
 
+// The bounds of a scene's numbers, refused at load beyond them, so that no product the
+// renderer forms of them leaves float's range (3.4e38): a radiance (an emission, a
+// sky's colour, an environment texel times its intensity) of at most 1e9, so that a
+// film's sum over the most samples (1e6) with the estimators' weights stays finite;
+// a position's coordinates and a radius of at most 1e15 in magnitude, so that squared
+// distances and cross products (1e30) do.
+constexpr float kMaxRadiance = 1e9f;
+constexpr float kMaxCoordinate = 1e15f;
+
 // Russian roulette starts at the latest after this many bounces (a path never gets
 // near it: depth is at most kMaxPathDepth).
 constexpr int kMaxRouletteDepth = 1 << 30;

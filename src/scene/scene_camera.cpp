@@ -1,4 +1,5 @@
 // Scene files: the camera, the sky and the render settings (docs/scene-format.md).
+#include <algorithm>
 #include <cmath>
 
 #include "render/settings.hpp"
@@ -9,8 +10,8 @@ namespace wt {
 void SceneReader::read_camera(const json& j, const JsonPath& path) {
   check_keys(j, path, {"look_from", "look_at", "up", "vfov", "aperture", "focus_distance"});
   CameraSpec& c = scene_.camera;
-  c.look_from = triple(required(j, path, "look_from"), path / "look_from");
-  c.look_at = triple(required(j, path, "look_at"), path / "look_at");
+  c.look_from = position(required(j, path, "look_from"), path / "look_from");
+  c.look_at = position(required(j, path, "look_at"), path / "look_at");
   if (j.contains("up")) c.up = triple(j["up"], path / "up");
   if (j.contains("vfov")) {
     c.vfov_degrees = number(j["vfov"], path / "vfov");
@@ -68,6 +69,16 @@ void SceneReader::read_sky(const json& j, const JsonPath& path) {
       srgb = cs == "srgb";
     }
     sky.image = image(string(required(j, path, "file"), path / "file"), srgb, path / "file");
+    float brightest = 0.0f;
+    const std::vector<float>& texels = scene_.images[static_cast<size_t>(sky.image)].texels;
+    for (size_t i = 0; i < texels.size(); ++i) {
+      if (i % 4 != 3) brightest = std::max(brightest, texels[i]);
+    }
+    if (static_cast<double>(brightest) * sky.intensity > kMaxRadiance) {
+      fail_at(j.contains("intensity") ? path / "intensity" : path / "file",
+              "the environment's brightest texel (" + std::to_string(brightest) + ") times its intensity (" +
+                  std::to_string(sky.intensity) + ") is more than 1e9, the most radiance a scene may hold");
+    }
   } else if (type == 0) {
     check_keys(j, path, {"type", "horizon", "zenith"}, "gradient");
     scene_.sky.kind = SkyKind::Gradient;

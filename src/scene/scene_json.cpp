@@ -2,6 +2,7 @@
 // file and the JSON path of the offending field, so that one message is enough to
 // find and fix it.
 #include <algorithm>
+#include <cmath>
 #include <thread>
 #include <utility>
 
@@ -64,7 +65,21 @@ vec3 SceneReader::colour(const json& j, const JsonPath& path) const {
 
 vec3 SceneReader::radiance(const json& j, const JsonPath& path) const {
   vec3 c = triple(j, path);
-  for (size_t i = 0; i < 3; ++i) non_negative(j[i], path / i);
+  for (size_t i = 0; i < 3; ++i) {
+    if (non_negative(j[i], path / i) > kMaxRadiance) {
+      fail_at(path / i, "must be at most 1e9, the most radiance a scene may hold (got " + j[i].dump() + ")");
+    }
+  }
+  return c;
+}
+
+vec3 SceneReader::position(const json& j, const JsonPath& path) const {
+  vec3 c = triple(j, path);
+  for (size_t i = 0; i < 3; ++i) {
+    if (std::fabs(c[static_cast<int>(i)]) > kMaxCoordinate) {
+      fail_at(path / i, "must be within +-1e15, the largest coordinate a scene may hold (got " + j[i].dump() + ")");
+    }
+  }
   return c;
 }
 
@@ -125,7 +140,7 @@ Scene parse_scene(const std::string& json_text, const std::string& source) {
 
 Scene load_scene(const std::string& path) {
   const auto start = Clock::now();
-  json root = read_json_file(path, "scene file");
+  json root = read_json_file(path, input::kScene);
   return prepare(std::move(root), path, seconds_since(start));
 }
 

@@ -41,7 +41,10 @@ class SceneReader : JsonReader {
   const std::string& name(const json& obj, const JsonPath& path) const;
   vec3 triple(const json& j, const JsonPath& path) const;
   vec3 colour(const json& j, const JsonPath& path) const;
+  // Each component in [0, kMaxRadiance].
   vec3 radiance(const json& j, const JsonPath& path) const;
+  // Each coordinate within +-kMaxCoordinate.
+  vec3 position(const json& j, const JsonPath& path) const;
   // Reads obj["type"] and returns its index in `types`.
   size_t type_of(const json& obj, const JsonPath& path, const std::string& what,
                  const std::vector<std::string>& types) const;

@@ -1,6 +1,8 @@
 // Scene files: textures, and the images that image textures and the environment read.
 #include <ImathBox.h>
 #include <ImfArray.h>
+#include <IexBaseExc.h>
+#include <ImfIO.h>
 #include <ImfRgbaFile.h>
 #include <stb/stb_image.h>
 
@@ -10,10 +12,9 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
-#include <fstream>
-#include <iterator>
 #include <utility>
 
+#include "scene/input_file.hpp"
 #include "scene/scene_reader.hpp"
 #include "wavetrace/film.hpp"
 
@@ -77,21 +78,35 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-// The bytes of a file for stb, and once the decoder has taken them all and asks for
-// more, a supply of newlines that never runs out, noting that it was drawn on.
-// stb's Radiance decoder reads a run-length count of 0 at the end of a truncated
-// file (its reads return 0 there) and loops without end. A newline ends the
-// header's lines (an empty line ends the header), and as a run-length count (10)
-// it always makes progress or an error, so the decoder ends; a decode that asked
-// for bytes past the file is reported as truncated. (stb asks again only for a
-// byte it needs: a short read ends its buffer where the file ends.)
-struct PaddedBytes {
+// Reads an image file whole (a regular file within the image limit); false with the
+// reason alone (the caller names the file).
+bool read_image_file(const std::string& path, std::string& bytes, std::string& why) {
+  try {
+    bytes = read_input_file(path, input::kImage);
+  } catch (const InputFileError& e) {
+    why = e.reason;
+    return false;
+  }
+  return true;
+}
+
+// The bytes of a file for stb, noting whether the decoder asked for more than the
+// file holds. For Radiance data, what follows the file is a supply of newlines that
+// never runs out: stb's Radiance decoder reads a run-length count of 0 at the end of
+// a truncated file (its reads return 0 there) and loops without end. A newline ends
+// the header's lines (an empty line ends the header), and as a run-length count
+// (10) it always makes progress or an error, so the decoder ends. For the other
+// formats nothing follows (stb ends on its own). (stb asks again only for a byte it
+// needs: a short read ends its buffer where the file ends; but its format probes
+// may ask past the end of a file of a few dozen bytes.)
+struct StbBytes {
   std::string bytes;
+  bool pad = false;  // newlines past the end (Radiance data)
   size_t at = 0;
   bool overran = false;
 
   static int read(void* user, char* data, int size) {
-    auto& p = *static_cast<PaddedBytes*>(user);
+    auto& p = *static_cast<StbBytes*>(user);
     if (size <= 0) return 0;
     if (p.at < p.bytes.size()) {
       const size_t n = std::min(static_cast<size_t>(size), p.bytes.size() - p.at);
@@ -99,50 +114,50 @@ struct PaddedBytes {
       p.at += n;
       return static_cast<int>(n);
     }
-    std::memset(data, '\n', static_cast<size_t>(size));
     p.overran = true;
+    if (!p.pad) return 0;
+    std::memset(data, '\n', static_cast<size_t>(size));
     return size;
   }
   static void skip(void* user, int n) {
-    auto& p = *static_cast<PaddedBytes*>(user);
+    auto& p = *static_cast<StbBytes*>(user);
     const int64_t to = static_cast<int64_t>(p.at) + n;
     p.at = to < 0 ? 0 : static_cast<size_t>(to);
   }
-  static int eof(void*) { return 0; }
+  static int eof(void* user) {
+    auto& p = *static_cast<StbBytes*>(user);
+    return p.pad ? 0 : p.at >= p.bytes.size();
+  }
 
-  // Reads the whole file; false with the reason.
   bool load(const std::string& path, std::string& why) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      why = std::string("cannot open it (") + std::strerror(errno) + ")";
-      return false;
-    }
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    if (in.bad()) {
-      why = "cannot read it";
-      return false;
-    }
+    if (!read_image_file(path, bytes, why)) return false;
+    pad = stbi_is_hdr_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(std::min<size_t>(
+                                                                                      bytes.size(), INT32_MAX))) != 0;
     return true;
   }
 };
 
 // Decodes `path` with one of stb's callback loaders (stbi_loadf_from_callbacks,
-// stbi_load_from_callbacks) over PaddedBytes, in the file's own channels. Null with
-// the reason when stb refuses the file or asked for bytes past its end.
+// stbi_load_from_callbacks) over StbBytes, in the file's own channels. Null with the
+// reason when stb refuses the file, saying so where the file ended before the decoder
+// was done, or where a Radiance decode needed bytes past its end.
 template <class Texel>
-Texel* decode_padded(const std::string& path, Texel* (*load)(const stbi_io_callbacks*, void*, int*, int*, int*, int),
-                     int& w, int& h, int& channels, std::string& why) {
-  PaddedBytes file;
+Texel* decode_with_stb(const std::string& path,
+                       Texel* (*load)(const stbi_io_callbacks*, void*, int*, int*, int*, int), int& w, int& h,
+                       int& channels, std::string& why) {
+  StbBytes file;
   if (!file.load(path, why)) return nullptr;
-  const stbi_io_callbacks callbacks{&PaddedBytes::read, &PaddedBytes::skip, &PaddedBytes::eof};
+  const stbi_io_callbacks callbacks{&StbBytes::read, &StbBytes::skip, &StbBytes::eof};
   Texel* data = load(&callbacks, &file, &w, &h, &channels, 0);
   if (!data) {
-    why = stbi_failure_reason();
+    why = file.overran ? "the file is cut short: it ends before its image does (" + std::string(stbi_failure_reason()) +
+                             ")"
+                       : stbi_failure_reason();
     return nullptr;
   }
-  if (file.overran) {
+  if (file.overran && file.pad) {
     stbi_image_free(data);
-    why = "the file ends before its pixels do";
+    why = "the file is cut short: it ends before its pixels do";
     return nullptr;
   }
   return data;
@@ -151,7 +166,7 @@ Texel* decode_padded(const std::string& path, Texel* (*load)(const stbi_io_callb
 // A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
 bool read_hdr(const std::string& path, Image& im, std::string& why) {
   int w = 0, h = 0, channels = 0;
-  float* data = decode_padded(path, &stbi_loadf_from_callbacks, w, h, channels, why);
+  float* data = decode_with_stb(path, &stbi_loadf_from_callbacks, w, h, channels, why);
   if (!data) return false;
   im.width = w;
   im.height = h;
@@ -168,16 +183,11 @@ bool read_hdr(const std::string& path, Image& im, std::string& why) {
 // An 8-bit image through stb, in the file's own channels widened to RGBA here
 // (stb 2.27, Debian bookworm, reads past its buffer when it converts a 16-bit PNM
 // to 4 channels), decoded from sRGB where `srgb` says. Radiance data under another
-// name (stb reads by content) goes through the padding read_hdr uses. False with
-// the reason.
+// name (stb reads by content) is padded as read_hdr's is. False with the reason.
 bool read_8bit(const std::string& path, bool srgb, Image& im, std::string& why) {
   int w = 0, h = 0, channels = 0;
-  stbi_uc* data = stbi_is_hdr(path.c_str()) ? decode_padded(path, &stbi_load_from_callbacks, w, h, channels, why)
-                                            : stbi_load(path.c_str(), &w, &h, &channels, 0);
-  if (!data) {
-    if (why.empty()) why = stbi_failure_reason();
-    return false;
-  }
+  stbi_uc* data = decode_with_stb(path, &stbi_load_from_callbacks, w, h, channels, why);
+  if (!data) return false;
   im.width = w;
   im.height = h;
   im.texels.resize(static_cast<size_t>(w) * h * 4);
@@ -193,10 +203,33 @@ bool read_8bit(const std::string& path, bool srgb, Image& im, std::string& why) 
   return true;
 }
 
+// OpenEXR's input stream over a file's bytes in memory (read_input_file).
+class ExrBytes : public Imf::IStream {
+ public:
+  ExrBytes(const std::string& path, const std::string& bytes) : Imf::IStream(path.c_str()), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || static_cast<uint64_t>(n) > bytes_.size() - std::min<uint64_t>(at_, bytes_.size())) {
+      throw Iex::InputExc("the file is cut short: it ends before its image does");
+    }
+    std::memcpy(c, bytes_.data() + at_, static_cast<size_t>(n));
+    at_ += static_cast<uint64_t>(n);
+    return at_ < bytes_.size();
+  }
+  uint64_t tellg() override { return at_; }
+  void seekg(uint64_t pos) override { at_ = pos; }
+
+ private:
+  const std::string& bytes_;
+  uint64_t at_ = 0;
+};
+
 // An OpenEXR file's RGBA through OpenEXR (missing channels read as 0, alpha as 1).
 bool read_exr(const std::string& path, Image& im, std::string& why) {
+  std::string bytes;
+  if (!read_image_file(path, bytes, why)) return false;
   try {
-    Imf::RgbaInputFile file(path.c_str());
+    ExrBytes stream(path, bytes);
+    Imf::RgbaInputFile file(stream);
     const Imath::Box2i window = file.dataWindow();
     const int64_t w64 = int64_t{window.max.x} - window.min.x + 1, h64 = int64_t{window.max.y} - window.min.y + 1;
     if (w64 <= 0 || h64 <= 0) {
@@ -239,11 +272,11 @@ bool read_exr(const std::string& path, Image& im, std::string& why) {
 bool check_radiance(const Image& im, std::string& why) {
   for (size_t i = 0; i < im.texels.size(); ++i) {
     const float v = im.texels[i];
-    if (!std::isfinite(v) || v < 0.0f) {
+    if (!std::isfinite(v) || v < 0.0f || v > kMaxRadiance) {
       const size_t p = i / 4;
       why = "texel (" + std::to_string(p % im.width) + ", " + std::to_string(p / im.width) + ") holds " +
             (std::isfinite(v) ? std::to_string(v) : std::string(std::isnan(v) ? "NaN" : "an infinity")) +
-            "; an image of radiance needs finite values of at least 0";
+            "; an image of radiance needs finite values in [0, 1e9]";
       return false;
     }
   }

@@ -1,0 +1,55 @@
+// Every file wavetrace reads (scene, jobs file, bench spec, mesh, MTL, texture and
+// environment image, glTF buffer, checkpoint) is read through here, whole and into
+// memory, before any library parses it: it must be a regular file (or a link to
+// one), and no larger than its kind's stated limit. A directory, a FIFO, a device or
+// a socket is refused at once with one line (never a hang: the file is opened
+// without blocking and checked before a byte is read), and so is a file past its
+// limit (never a read that grows without bound, as /dev/zero would).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "scene/scene.hpp"
+
+namespace wt {
+
+// What read_input_file throws: the whole line, and its reason alone ("it is a
+// directory, not a file", "cannot open it (No such file or directory)") for a caller
+// that names the file in words of its own.
+struct InputFileError : SceneError {
+  InputFileError(const std::string& line, std::string why) : SceneError(line), reason(std::move(why)) {}
+  std::string reason;
+};
+
+// The kind of an input file: its name in messages and the most bytes it may hold.
+struct InputKind {
+  const char* what;
+  uint64_t max_bytes;
+};
+
+namespace input {
+constexpr uint64_t kMiB = uint64_t{1} << 20;
+constexpr uint64_t kGiB = uint64_t{1} << 30;
+constexpr InputKind kScene{"scene file", 256 * kMiB};
+constexpr InputKind kJobs{"jobs file", 64 * kMiB};
+constexpr InputKind kBenchSpec{"bench spec", 16 * kMiB};
+// tinygltf takes a file's size as an unsigned int: under 4 GiB.
+constexpr InputKind kMesh{"mesh file", 4 * kGiB - 1};
+constexpr InputKind kMaterialLibrary{"material library", 64 * kMiB};
+constexpr InputKind kGltfBuffer{"glTF buffer", 4 * kGiB - 1};
+constexpr InputKind kImage{"image", 2 * kGiB};
+// The largest film the settings allow (16384 x 16384 x 3 floats) and its header.
+constexpr InputKind kCheckpoint{"checkpoint", 3 * kGiB + 16 * kMiB};
+}  // namespace input
+
+// The whole file. Throws InputFileError "<path>: cannot open <what> (<reason>)", or
+// "<path>: cannot read <what>: ..." for a file that is not regular or is too large.
+std::string read_input_file(const std::string& path, const InputKind& kind);
+
+// Why `path` cannot be read as an input file of this kind (it does not exist, is a
+// directory, a FIFO, a device, a socket, a loop of links, or is past the limit),
+// in the words read_input_file would use after the path; empty where it can.
+std::string input_file_problem(const std::string& path, const InputKind& kind);
+
+}  // namespace wt
