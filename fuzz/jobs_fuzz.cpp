@@ -1,5 +1,5 @@
-// The jobs-file reader over arbitrary file contents: is_jobs_file never throws,
-// read_jobs_file either plans jobs or throws SceneError.
+// The jobs-file reader over arbitrary file contents: batch_input and read_jobs_file
+// each either answer or throw SceneError.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -9,7 +9,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::string path = wt::fuzz::write_input("jobs.json", data, size);
-  wt::app::is_jobs_file(path);
+  try {
+    wt::app::batch_input(path);
+  } catch (const wt::SceneError&) {
+  }
   try {
     wt::app::read_jobs_file(path, wt::app::Job{});
   } catch (const wt::SceneError&) {

@@ -324,8 +324,21 @@ TEST_F(JobTest, JobsFilesTakeExrFloatAsABoolean) {
 }
 
 TEST_F(JobTest, JobsFilesRejectRepeatedAndUnknownKeys) {
-  std::string jobs = write("jobs.json", R"({"jobs": [{"scene": "a.json", "scene": "b.json", "output": "o.png"}]})");
-  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }), jobs + ": /jobs/0/scene: duplicate key");
+  // A key repeated inside one job fails that job alone; outside the jobs, the file.
+  std::string jobs = write("jobs.json", R"({"jobs": [{"scene": "a.json", "scene": "b.json", "output": "o.png"},
+    {"scene": "a.json", "output": "p.png", "spp": 2, "spp": 3}, {"scene": "a.json", "output": "q.png"},
+    {"scene": "a.json", "output": "r.png", "more": {"x": 1, "x": 2}}]})");
+  std::vector<PlannedJob> planned = read_jobs_file(jobs, Job{});
+  ASSERT_EQ(planned.size(), 4u);
+  EXPECT_EQ(planned[0].error, jobs + ": /jobs/0/scene: duplicate key");
+  EXPECT_EQ(planned[1].error, jobs + ": /jobs/1/spp: duplicate key");
+  EXPECT_EQ(planned[2].error, "");
+  EXPECT_EQ(planned[2].job.output, path("q.png"));
+  EXPECT_EQ(planned[3].error, jobs + ": /jobs/3/more/x: duplicate key");
+  jobs = write("jobs.json", R"({"defaults": {"spp": 2, "spp": 3}, "jobs": [{"scene": "a.json", "output": "o.png"}]})");
+  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }), jobs + ": /defaults/spp: duplicate key");
+  jobs = write("jobs.json", R"({"jobs": [], "jobs": []})");
+  EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }), jobs + ": /jobs: duplicate key");
   jobs = write("jobs.json", R"({"jobs": [], "default": {}})");
   EXPECT_EQ(error_of([&] { read_jobs_file(jobs, Job{}); }),
             jobs + ": /default: unknown key (expected jobs, defaults)");

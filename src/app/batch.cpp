@@ -6,9 +6,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <cctype>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -78,17 +79,47 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
   }
 }
 
+// The job a JSON pointer lies inside ("/jobs/3/spp": 3); none for one outside every
+// job ("/defaults/spp", "/jobs").
+std::optional<size_t> job_of_pointer(const std::string& at) {
+  const std::string prefix = "/jobs/";
+  if (at.rfind(prefix, 0) != 0) return std::nullopt;
+  const size_t digits_end = at.find('/', prefix.size());
+  if (digits_end == std::string::npos || digits_end == prefix.size()) return std::nullopt;
+  size_t job = 0;
+  for (size_t i = prefix.size(); i < digits_end; ++i) {
+    if (!std::isdigit(static_cast<unsigned char>(at[i])) || job > SIZE_MAX / 10 - 1) return std::nullopt;
+    job = job * 10 + static_cast<size_t>(at[i] - '0');
+  }
+  return job;
+}
+
 }  // namespace
 
-bool is_jobs_file(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) return false;
-  json doc = json::parse(f, nullptr, false);
-  return !doc.is_discarded() && doc.is_object() && doc.contains("jobs");
+BatchInput batch_input(const std::string& path) {
+  // Either kind of file, so the larger limit of the two.
+  const std::string text = read_input_file(path, InputKind{"jobs file or scene file", input::kScene.max_bytes});
+  const json doc = json::parse(text, nullptr, false);
+  if (doc.is_discarded()) parse_json(text, path);  // throws, saying where the JSON breaks
+  if (doc.is_object() && doc.contains("jobs")) return BatchInput::JobsFile;
+  if (doc.is_object() && doc.contains("camera")) return BatchInput::Scene;
+  if (doc.is_object() && doc.contains("defaults")) {
+    throw SceneError(path + ": /jobs: required key is missing (a jobs file lists its jobs under \"jobs\")");
+  }
+  throw SceneError(path + ": neither a jobs file nor a scene file: a jobs file needs \"jobs\" (a list of jobs), a "
+                          "scene file \"camera\" and \"materials\"");
 }
 
 std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base) {
-  const json doc = read_json_file(path, "jobs file");
+  // A key repeated inside one job fails that job alone; anywhere else, the file.
+  std::vector<std::string> duplicates;
+  const json doc = parse_json(read_input_file(path, input::kJobs), path, &duplicates);
+  std::map<size_t, std::string> job_duplicates;
+  for (const std::string& at : duplicates) {
+    const std::optional<size_t> job = job_of_pointer(at);
+    if (!job) throw SceneError(path + ": " + at + ": duplicate key");
+    job_duplicates.emplace(*job, path + ": " + at + ": duplicate key");
+  }
   const JsonReader r(path);
   const JsonPath top;
   r.check_keys(doc, top, {"jobs", "defaults"});
@@ -102,6 +133,7 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
     PlannedJob planned{defaults, ""};
     const JsonPath at = jobs_path / i;
     try {
+      if (auto d = job_duplicates.find(i); d != job_duplicates.end()) throw SceneError(d->second);
       apply_fields(r, list[i], at, folder, planned.job);
       if (planned.job.scene.empty()) r.fail_at(at / "scene", "required key is missing (in the job or its defaults)");
       if (planned.job.output.empty()) r.fail_at(at / "output", "required key is missing (in the job or its defaults)");
@@ -268,8 +300,13 @@ int run_jobs(const std::vector<PlannedJob>& jobs, bool skip_done, const JobRunne
 
 // What a job's stats file says about its render, for the summary.
 void read_measurements(const std::string& path, JobOutcome& o) {
-  std::ifstream f(path);
-  const json j = json::parse(f, nullptr, false);
+  std::string text;
+  try {
+    text = read_input_file(path, InputKind{"stats file", input::kJobs.max_bytes});
+  } catch (const SceneError&) {
+    return;
+  }
+  const json j = json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return;
   for (SettingId id : render_settings()) set_param(o.params, id, j["settings"].value(setting(id).key, int64_t(0)));
   o.backend = j.value("backend", "");

@@ -16,8 +16,12 @@ struct PlannedJob {
 };
 std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base);
 
-// Whether a file parses as JSON with a top-level "jobs" key (a scene file has none).
-bool is_jobs_file(const std::string& path);
+// What the one input of `wavetrace batch` is: a jobs file (a JSON object with "jobs")
+// or a scene file (one with "camera"). Throws SceneError naming the file where it
+// cannot be read, is not JSON, or is neither (a jobs file without "jobs" is not
+// taken for a scene).
+enum class BatchInput { JobsFile, Scene };
+BatchInput batch_input(const std::string& path);
 
 // Runs every job in this process, prints a summary table, returns the exit code
 // (non-zero if any failed). `skip_done`: jobs whose image exists are skipped (a batch

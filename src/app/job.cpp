@@ -1,6 +1,8 @@
 #include "app/job.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -11,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/checkpoint.hpp"
+#include "app/job_files.hpp"
 #include "app/distributed.hpp"
 #include "app/progress.hpp"
 #include "app/signals.hpp"
@@ -101,7 +104,23 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
   }
 }
 
+const std::string& checkpoint_of(const Job& job) { return job.checkpoint.empty() ? job.resume : job.checkpoint; }
+
+uint64_t count_nonfinite_pixels(const std::vector<float>& rgb) {
+  uint64_t n = 0;
+  for (size_t p = 0; p + 2 < rgb.size(); p += 3) {
+    n += !(std::isfinite(rgb[p]) && std::isfinite(rgb[p + 1]) && std::isfinite(rgb[p + 2]));
+  }
+  return n;
+}
+
 namespace {
+
+bool is_png(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png";
+}
 
 RenderParams resolve_params(const Scene& scene, const Job& job) {
   RenderParams p = default_params(scene);
@@ -232,11 +251,18 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
 
   std::optional<Scene> scene;
   RenderOptions options;
+  // Held from before the checkpoint is read until the image is written.
+  CheckpointLock checkpoint_lock;
   guarded(out, [&] {
-    // Of an MPI run, rank 0 alone writes.
+    // Of an MPI run, rank 0 alone writes. Every file the job writes is checked before
+    // the scene loads: a bad path costs nothing, and no output may overwrite another.
     if (cluster.root()) {
       check_output_path(job.output);
       if (!job.stats.empty()) check_output_path_for_text(job.stats);
+      check_distinct_files(job);
+      check_creatable(job.output, "image");
+      if (!job.stats.empty()) check_creatable(job.stats, "stats file");
+      if (!distributed && !checkpoint_of(job).empty()) check_creatable(checkpoint_of(job), "checkpoint");
     }
     scene.emplace(load_scene(job.scene));
     out.load_times = scene->load_times;
@@ -290,10 +316,13 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
       return;
     }
     // Checkpoints go to job.checkpoint, or back into the file resumed from.
-    const std::string checkpoint_path = job.checkpoint.empty() ? job.resume : job.checkpoint;
+    const std::string& checkpoint_path = checkpoint_of(job);
     Checkpoint resumed;
     std::optional<SignalCatcher> signals;
+    // Once a pass says stop, the render ends as it is: its progress line stays where it was.
+    std::atomic<bool> stopping{false};
     if (!checkpoint_path.empty()) {
+      checkpoint_lock = CheckpointLock(checkpoint_path);
       const CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
       const std::string from =
           !job.resume.empty() ? job.resume : (std::filesystem::exists(job.checkpoint) ? job.checkpoint : "");
@@ -310,6 +339,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
       options.after_pass = [&, identity, last_write = std::chrono::steady_clock::now()](
                                int32_t samples, const FilmReader& film) mutable {
         const bool stop = signals->caught() != 0;
+        if (stop) stopping = true;
         const auto now = std::chrono::steady_clock::now();
         if (stop || (samples < rp.spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {
           write_checkpoint(checkpoint_path, Checkpoint{identity, samples, film()});
@@ -326,7 +356,11 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
       take_mean(out.result);
     } else {
       ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
-      if (job.progress) options.progress = progress.callback();
+      if (job.progress) {
+        options.progress = [&stopping, draw = progress.callback()](double done, uint64_t rays, double seconds) {
+          if (!stopping) draw(done, rays, seconds);
+        };
+      }
       out.result = render(*scene, options);
     }
     if (out.result.interrupted) {
@@ -349,6 +383,14 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     if (distributed) take_mean(out.result);
     // Both files are written in full before either takes its name: a disk that fills
     // up during the second leaves neither.
+    out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
+    if (out.nonfinite_pixels > 0) {
+      std::fprintf(stderr,
+                   "wavetrace: %s: warning: %llu pixels are not finite (NaN or an infinity); %s\n", job.output.c_str(),
+                   static_cast<unsigned long long>(out.nonfinite_pixels),
+                   is_png(job.output) ? "the PNG holds them as 0 (NaN) and 255 (infinity)"
+                                      : "the image holds them as they are");
+    }
     const auto write_start = std::chrono::steady_clock::now();
     StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
                                    job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
@@ -371,6 +413,11 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
 
 void print_outcome(const Job& job, const JobOutcome& o) {
   const RenderResult& r = o.result;
+  if (o.resumed_from_sample > 0 && o.resumed_from_sample >= o.params.spp) {
+    std::fprintf(stderr, "%s: every one of its %d samples was in the checkpoint %s; nothing was left to render\n",
+                 job.output.c_str(), o.params.spp, checkpoint_of(job).c_str());
+    return;
+  }
   std::fprintf(stderr, "%s: %s/%s on %s: %.3f s, %llu rays, %.1f M rays/s, %.1f M paths/s\n", job.output.c_str(),
                o.backend.c_str(), o.kernel.c_str(), r.device.c_str(), r.seconds,
                static_cast<unsigned long long>(r.rays), r.rays / r.seconds / 1e6, r.paths / r.seconds / 1e6);

@@ -63,6 +63,9 @@ struct JobOutcome {
   // Wall clock of the whole job up to its image written, from the start of run_job
   // (scene, device set-up, render, image), and of encoding and writing the image.
   double job_seconds = 0, write_seconds = 0;
+  // Pixels of the image that are not finite (a NaN or an infinity in any channel): said
+  // on stderr and in the stats, never written silently.
+  uint64_t nonfinite_pixels = 0;
 };
 
 // Runs a job; never throws. Writes the image (and stats) only when the render and
@@ -81,6 +84,12 @@ JobOutcome run_job(const Job& job, const Cluster& cluster);
 void set_setting(Job& job, SettingId id, int64_t value);
 // A setting the job was given: its value, or none where the job keeps the default.
 std::optional<int64_t> given_setting(const Job& job, SettingId id);
+
+// The checkpoint a job writes: --checkpoint, or else the --resume file (written back to).
+const std::string& checkpoint_of(const Job& job);
+
+// Pixels (RGB triples) with a NaN or an infinity in any channel.
+uint64_t count_nonfinite_pixels(const std::vector<float>& rgb);
 
 Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
 // Job::devices as the render's device list for `backend` (`present`: CUDA devices

@@ -1,15 +1,19 @@
 // The wavetrace command: render one scene, or a batch of jobs.
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <utility>
 
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/cluster.hpp"
 #include "app/cli.hpp"
 #include "app/job.hpp"
+#include "app/job_files.hpp"
 #include "cuda/device.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -23,6 +27,9 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster);
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A write past a file-size limit fails with EFBIG, which the writers report (their
+  // temporary file removed), rather than killing the process.
+  std::signal(SIGXFSZ, SIG_IGN);
   // Under an MPI launcher, this process is one rank of several (app/cluster.hpp).
   wt::app::Cluster cluster;
   try {
@@ -79,19 +86,33 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   kernels->add_option("--backend", kernels_backend, "only those that run on this backend: cuda or cpu")
       ->check(CLI::IsMember({"cuda", "cpu"}));
 
+  const auto refuse = [&](const std::string& what) {
+    if (cluster.distributed()) {
+      // The other ranks may have parsed theirs, and wait for this one: the run ends here.
+      std::fprintf(stderr, "wavetrace: %s: %s; the MPI run is stopped\n", cluster.name(cluster.rank()).c_str(),
+                   what.c_str());
+      std::fflush(stderr);
+      wt::app::abort_cluster(wt::app::kExitBadInput);
+    }
+    std::fprintf(stderr, "wavetrace: %s\n", what.c_str());
+    return wt::app::kExitBadInput;
+  };
+  // A first word that is no command is named as such (CLI11 would call it an argument).
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::function<bool(const CLI::App*)> listed = [](const CLI::App* c) { return !c->get_group().empty(); };
+    std::vector<std::string> commands;
+    for (const CLI::App* c : std::as_const(app).get_subcommands(listed)) commands.push_back(c->get_name());
+    try {
+      app.get_subcommand(argv[1]);
+    } catch (const CLI::OptionNotFound&) {
+      return refuse(std::string("unknown command '") + argv[1] + "' (the commands: " + wt::listed(commands) + ")");
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
-    if (cluster.distributed()) {
-      // The other ranks may have parsed theirs, and wait for this one: the run ends here.
-      std::fprintf(stderr, "wavetrace: %s: %s; the MPI run is stopped\n", cluster.name(cluster.rank()).c_str(),
-                   e.what());
-      std::fflush(stderr);
-      wt::app::abort_cluster(wt::app::kExitBadInput);
-    }
-    std::fprintf(stderr, "wavetrace: %s\n", e.what());
-    return wt::app::kExitBadInput;
+    return refuse(e.what());
   }
 
   if (*worker) return wt::app::run_batch_worker();
@@ -148,7 +169,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   }
   try {
     // One input that is a jobs file; otherwise every input is a scene file.
-    if (inputs.size() == 1 && wt::app::is_jobs_file(inputs[0])) {
+    if (inputs.size() == 1 && wt::app::batch_input(inputs[0]) == wt::app::BatchInput::JobsFile) {
       jobs = wt::app::read_jobs_file(inputs[0], batch_job);
     } else {
       for (const std::string& scene : inputs) {
@@ -162,6 +183,20 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
+  }
+  // Jobs that would write one file are refused together, before any job runs.
+  {
+    std::vector<Job> planned;
+    std::vector<bool> refused;
+    for (const wt::app::PlannedJob& pj : jobs) {
+      planned.push_back(pj.job);
+      refused.push_back(!pj.error.empty());
+    }
+    if (const std::string collision = wt::app::colliding_jobs(planned, refused); !collision.empty()) {
+      std::fprintf(stderr, "wavetrace: %s\n", collision.c_str());
+      if (cluster.distributed()) wt::app::release_ranks(cluster);
+      return wt::app::kExitBadInput;
+    }
   }
   // Each job runs as `wavetrace render` in a process of its own: a clean CUDA context
   // for every job, whatever the one before it did to its own. With several CUDA

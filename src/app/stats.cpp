@@ -107,6 +107,7 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["kernel"] = o.kernel;
   j["device"] = r.device;
   j["seconds"] = r.seconds;
+  j["nonfinite_pixels"] = o.nonfinite_pixels;
   if (o.resumed_from_sample > 0) j["resumed_from_sample"] = o.resumed_from_sample;
   if (o.ranks > 1) {
     j["ranks"] = o.ranks;

@@ -1,0 +1,172 @@
+#include "app/job_files.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <utility>
+
+#include "image/image_io.hpp"
+
+namespace wt::app {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The path made absolute, the links of its existing part resolved.
+std::string resolved_path(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  if (ec) p = fs::absolute(path, ec).lexically_normal();
+  return p.string();
+}
+
+}  // namespace
+
+std::string file_key(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+  }
+  return resolved_path(path);
+}
+
+std::vector<JobFile> job_files(const Job& job) {
+  std::vector<JobFile> files;
+  const auto add = [&](const char* field, const std::string& path, bool written) {
+    if (!path.empty()) files.push_back({field, path, written});
+  };
+  add("output", job.output, true);
+  add("stats", job.stats, true);
+  add("checkpoint", job.checkpoint, true);
+  // Without --checkpoint the resume file is written back to.
+  add("resume", job.resume, job.checkpoint.empty());
+  add("scene", job.scene, false);
+  return files;
+}
+
+void check_distinct_files(const Job& job) {
+  const std::vector<JobFile> files = job_files(job);
+  std::vector<std::string> keys;
+  for (const JobFile& f : files) keys.push_back(file_key(f.path));
+  for (size_t a = 0; a < files.size(); ++a) {
+    for (size_t b = a + 1; b < files.size(); ++b) {
+      if (keys[a] != keys[b] || !(files[a].written || files[b].written)) continue;
+      // A checkpoint resumed and written to is one file, meant to be.
+      if (files[a].field == std::string("checkpoint") && files[b].field == std::string("resume")) continue;
+      throw OutputError(files[b].path + ": " + files[a].field + " and " + files[b].field +
+                        " name the same file (" + files[a].path + " and " + files[b].path +
+                        "); each of a render's files needs a file of its own");
+    }
+  }
+}
+
+void check_creatable(const std::string& path, const std::string& field) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode)) {
+    throw OutputError(path + ": cannot write the " + field + ": " +
+                      (S_ISDIR(st.st_mode) ? "it is a folder" : "it exists and is not a regular file"));
+  }
+  // The file is written beside its name and renamed into place (image_io.hpp): try that
+  // name, and remove it at once.
+  const std::string probe = path + ".tmp." + std::to_string(::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    if (errno == EEXIST) return;
+    const int err = errno;
+    throw OutputError(path + ": cannot write the " + field + " (" + std::strerror(err) + ")");
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+CheckpointLock::CheckpointLock(const std::string& checkpoint) {
+  const std::string lock_path = resolved_path(checkpoint) + ".lock";
+  // The lock file's last holder removes it as it lets go: a lock taken on a file that
+  // no longer has the name is let go, and the name tried again.
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    const int fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+    if (fd < 0) {
+      const int err = errno;
+      throw OutputError(checkpoint + ": cannot lock the checkpoint: cannot create " + lock_path + " (" +
+                        std::strerror(err) + ")");
+    }
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      const int err = errno;
+      char pid[32] = {};
+      const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
+      ::close(fd);
+      if (err == EWOULDBLOCK) {
+        throw OutputError(checkpoint + ": the checkpoint is in use by another wavetrace process" +
+                          (n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : std::string()) +
+                          "; two renders cannot share one checkpoint");
+      }
+      throw OutputError(checkpoint + ": cannot lock the checkpoint (" + std::string(std::strerror(err)) + ")");
+    }
+    struct stat held {}, named {};
+    if (::fstat(fd, &held) == 0 && ::stat(lock_path.c_str(), &named) == 0 && held.st_dev == named.st_dev &&
+        held.st_ino == named.st_ino) {
+      const std::string pid = std::to_string(::getpid());
+      if (::ftruncate(fd, 0) != 0 || ::pwrite(fd, pid.data(), pid.size(), 0) < 0) {
+        // The pid is only for the message another process prints.
+      }
+      lock_path_ = lock_path;
+      fd_ = fd;
+      return;
+    }
+    ::close(fd);
+  }
+  throw OutputError(checkpoint + ": cannot lock the checkpoint: its lock file " + lock_path + " keeps changing");
+}
+
+CheckpointLock::~CheckpointLock() { release(); }
+
+CheckpointLock::CheckpointLock(CheckpointLock&& o) noexcept
+    : lock_path_(std::move(o.lock_path_)), fd_(std::exchange(o.fd_, -1)) {}
+
+CheckpointLock& CheckpointLock::operator=(CheckpointLock&& o) noexcept {
+  if (this != &o) {
+    release();
+    lock_path_ = std::move(o.lock_path_);
+    fd_ = std::exchange(o.fd_, -1);
+  }
+  return *this;
+}
+
+void CheckpointLock::release() noexcept {
+  if (fd_ < 0) return;
+  // Removed while still held, so that no other process takes a lock on it meanwhile.
+  ::unlink(lock_path_.c_str());
+  ::close(fd_);
+  fd_ = -1;
+}
+
+std::string colliding_jobs(const std::vector<Job>& jobs, const std::vector<bool>& refused) {
+  std::map<std::string, std::pair<size_t, std::string>> writers;  // file -> (job, field)
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    if (i < refused.size() && refused[i]) continue;
+    std::map<std::string, bool> own;  // a job's own files are check_distinct_files's
+    for (const JobFile& f : job_files(jobs[i])) {
+      if (!f.written) continue;
+      const std::string key = file_key(f.path);
+      if (own.count(key)) continue;
+      own[key] = true;
+      auto [it, added] = writers.emplace(key, std::make_pair(i, f.field));
+      if (!added) {
+        return "jobs " + std::to_string(it->second.first + 1) + " and " + std::to_string(i + 1) +
+               " would write the same file " + f.path + " (the " + it->second.second + " of job " +
+               std::to_string(it->second.first + 1) + ", the " + f.field + " of job " + std::to_string(i + 1) +
+               "); the batch is refused before any job runs";
+      }
+    }
+  }
+  return "";
+}
+
+}  // namespace wt::app
