@@ -262,7 +262,10 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
       check_distinct_files(job);
       check_creatable(job.output, "image");
       if (!job.stats.empty()) check_creatable(job.stats, "stats file");
-      if (!distributed && !checkpoint_of(job).empty()) check_creatable(checkpoint_of(job), "checkpoint");
+      if (!distributed && !checkpoint_of(job).empty()) {
+        check_output_folder(checkpoint_of(job));
+        check_creatable(checkpoint_of(job), job.checkpoint.empty() ? "resume file (written back to)" : "checkpoint");
+      }
     }
     scene.emplace(load_scene(job.scene));
     out.load_times = scene->load_times;

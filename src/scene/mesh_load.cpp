@@ -577,6 +577,10 @@ class GltfReader {
         if (child < 0 || static_cast<size_t>(child) >= n) {
           fail(path, "node " + std::to_string(i) + ": child index " + std::to_string(child) + " out of range");
         }
+        if (parent[child] == static_cast<int64_t>(i)) {
+          fail(path, "node " + std::to_string(child) + " is listed twice as a child of node " + std::to_string(i) +
+                         "; glTF nodes form a forest, each node with one parent at most");
+        }
         if (parent[child] >= 0) {
           fail(path, "node " + std::to_string(child) + " has two parents (nodes " + std::to_string(parent[child]) +
                          " and " + std::to_string(i) + "); glTF nodes form a forest, each node with one parent at most");

@@ -103,7 +103,8 @@ struct StbBytes {
   std::string bytes;
   bool pad = false;  // newlines past the end (Radiance data)
   size_t at = 0;
-  bool overran = false;
+  bool overran = false;    // asked for bytes with none left
+  bool short_read = false;  // asked for more bytes than were left (a valid file's last read may be)
 
   static int read(void* user, char* data, int size) {
     auto& p = *static_cast<StbBytes*>(user);
@@ -112,6 +113,7 @@ struct StbBytes {
       const size_t n = std::min(static_cast<size_t>(size), p.bytes.size() - p.at);
       std::memcpy(data, p.bytes.data() + p.at, n);
       p.at += n;
+      p.short_read = p.short_read || (n < static_cast<size_t>(size) && p.at > n);  // not the first read
       return static_cast<int>(n);
     }
     p.overran = true;
@@ -150,9 +152,11 @@ Texel* decode_with_stb(const std::string& path,
   const stbi_io_callbacks callbacks{&StbBytes::read, &StbBytes::skip, &StbBytes::eof};
   Texel* data = load(&callbacks, &file, &w, &h, &channels, 0);
   if (!data) {
-    why = file.overran ? "the file is cut short: it ends before its image does (" + std::string(stbi_failure_reason()) +
-                             ")"
-                       : stbi_failure_reason();
+    // (A file that no decoder recognises may be shorter than their probes read.)
+    const std::string reason = stbi_failure_reason();
+    why = (file.overran || file.short_read) && reason != "unknown image type"
+              ? "the file is cut short: it ends before its image does (" + reason + ")"
+              : reason;
     return nullptr;
   }
   if (file.overran && file.pad) {
