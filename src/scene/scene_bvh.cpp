@@ -2,6 +2,7 @@
 // each mesh), the instances that place them, and the top-level BVH over those.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "scene/scene.hpp"
@@ -128,6 +129,18 @@ void build_bvh(Scene& scene) {
     const auto& tree = p.mesh == kSpheres ? sphere_tree : mesh_trees[p.mesh];
     boxes[i].box = world_box(node_bounds(tree[0]), p);
     boxes[i].centroid = boxes[i].box.centre();
+    if (p.mesh != kSpheres) {
+      const vec3 far = glm::max(glm::abs(boxes[i].box.lo), glm::abs(boxes[i].box.hi));
+      const float reach = std::max(far.x, std::max(far.y, far.z));
+      if (!(reach <= kMaxCoordinate)) {
+        const size_t instance = i - (scene.spheres.empty() ? 0 : 1);  // the spheres' placement comes first
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", static_cast<double>(reach));
+        throw SceneError(scene.source + ": /instances/" + std::to_string(instance) + ": the placed mesh '" +
+                         scene.meshes[p.mesh].name + "' reaches a coordinate of " + value +
+                         ", beyond +-1e15, the largest a scene may hold");
+      }
+    }
   }
   BvhTree top;
   try {
