@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "image/image_io.hpp"
+#include "scene/input_file.hpp"
 
 namespace wt::app {
 
@@ -70,8 +71,7 @@ void check_distinct_files(const Job& job) {
 void check_creatable(const std::string& path, const std::string& field) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode)) {
-    throw OutputError(path + ": cannot write the " + field + ": " +
-                      (S_ISDIR(st.st_mode) ? "it is a folder" : "it exists and is not a regular file"));
+    throw OutputError(path + ": cannot write the " + field + ": " + not_a_regular_file(st.st_mode));
   }
   // The file is written beside its name and renamed into place (image_io.hpp): try that
   // name, and remove it at once.

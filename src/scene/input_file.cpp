@@ -50,15 +50,7 @@ InputFileError read_refusal(const std::string& path, const InputKind& kind, cons
 
 }  // namespace
 
-std::string input_file_problem(const std::string& path, const InputKind& kind) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) return open_failure(path, kind, errno).what();
-  if (const std::string what = not_regular(st.st_mode); !what.empty()) return read_refusal(path, kind, what).what();
-  if (static_cast<uint64_t>(st.st_size) > kind.max_bytes) {
-    return read_refusal(path, kind, too_large(static_cast<uint64_t>(st.st_size), kind)).what();
-  }
-  return "";
-}
+std::string not_a_regular_file(unsigned int mode) { return not_regular(static_cast<mode_t>(mode)); }
 
 std::string read_input_file(const std::string& path, const InputKind& kind) {
   // O_NONBLOCK: opening a FIFO does not wait for a writer; the file is then checked

@@ -47,9 +47,8 @@ constexpr InputKind kCheckpoint{"checkpoint", 3 * kGiB + 16 * kMiB};
 // "<path>: cannot read <what>: ..." for a file that is not regular or is too large.
 std::string read_input_file(const std::string& path, const InputKind& kind);
 
-// Why `path` cannot be read as an input file of this kind (it does not exist, is a
-// directory, a FIFO, a device, a socket, a loop of links, or is past the limit),
-// in the words read_input_file would use after the path; empty where it can.
-std::string input_file_problem(const std::string& path, const InputKind& kind);
+// What a file of this st_mode is where it is not a regular file, in words ("it is a
+// FIFO (named pipe), not a regular file"); empty for a regular file.
+std::string not_a_regular_file(unsigned int mode);
 
 }  // namespace wt
