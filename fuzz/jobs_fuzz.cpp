@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "app/batch.hpp"
+#include "app/jobs_file.hpp"
 #include "fuzz_support.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -4,24 +4,9 @@
 #include <vector>
 
 #include "app/job.hpp"
+#include "app/jobs_file.hpp"
 
 namespace wt::app {
-
-// Jobs from a jobs file: {"defaults": {...}, "jobs": [{"scene": ..., "output": ..., ...}]}.
-// Paths inside it are relative to the file. A malformed file throws SceneError; a bad
-// job becomes a job whose error is reported when it runs.
-struct PlannedJob {
-  Job job;
-  std::string error;  // non-empty: the job cannot run, and this says why
-};
-std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base);
-
-// What the one input of `wavetrace batch` is: a jobs file (a JSON object with "jobs")
-// or a scene file (one with "camera"). Throws SceneError naming the file where it
-// cannot be read, is not JSON, or is neither (a jobs file without "jobs" is not
-// taken for a scene).
-enum class BatchInput { JobsFile, Scene };
-BatchInput batch_input(const std::string& path);
 
 // Runs every job in this process, prints a summary table, returns the exit code
 // (non-zero if any failed). `skip_done`: jobs whose image exists are skipped (a batch

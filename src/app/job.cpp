@@ -58,52 +58,6 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
   return out;
 }
 
-namespace {
-
-// The job's field for a render setting (const or not, as the job); null for the others.
-template <class J>
-auto render_override(J& job, SettingId id) -> decltype(&job.width) {
-  switch (id) {
-    case SettingId::Width: return &job.width;
-    case SettingId::Height: return &job.height;
-    case SettingId::Spp: return &job.spp;
-    case SettingId::Depth: return &job.depth;
-    case SettingId::RouletteDepth: return &job.roulette_depth;
-    case SettingId::Seed: return &job.seed;
-    case SettingId::Nee: return &job.nee;
-    default: return nullptr;
-  }
-}
-
-}  // namespace
-
-void set_setting(Job& job, SettingId id, int64_t value) {
-  if (std::optional<int64_t>* o = render_override(job, id)) {
-    *o = value;
-  } else if (id == SettingId::Warmup) {
-    job.warmup = value;
-  } else if (id == SettingId::WaveSize) {
-    job.wave_size = value;
-  } else if (id == SettingId::Threads) {
-    job.threads = value;
-  } else if (id == SettingId::CheckpointEvery) {
-    job.checkpoint_every = value;
-  }
-}
-
-std::optional<int64_t> given_setting(const Job& job, SettingId id) {
-  if (const std::optional<int64_t>* o = render_override(job, id)) return *o;
-  static const Job defaults;
-  const auto unless_default = [](int64_t v, int64_t d) { return v == d ? std::nullopt : std::optional<int64_t>(v); };
-  switch (id) {
-    case SettingId::Warmup: return unless_default(job.warmup, defaults.warmup);
-    case SettingId::WaveSize: return unless_default(job.wave_size, defaults.wave_size);
-    case SettingId::Threads: return unless_default(job.threads, defaults.threads);
-    case SettingId::CheckpointEvery: return unless_default(job.checkpoint_every, defaults.checkpoint_every);
-    default: return std::nullopt;
-  }
-}
-
 const std::string& checkpoint_of(const Job& job) { return job.checkpoint.empty() ? job.resume : job.checkpoint; }
 
 uint64_t count_nonfinite_pixels(const std::vector<float>& rgb) {
@@ -125,7 +79,7 @@ bool is_png(const std::string& path) {
 RenderParams resolve_params(const Scene& scene, const Job& job) {
   RenderParams p = default_params(scene);
   for (SettingId id : render_settings()) {
-    if (const std::optional<int64_t>& v = *render_override(job, id)) set_param(p, id, *v);
+    if (const std::optional<int64_t> v = given_setting(job, id)) set_param(p, id, *v);
   }
   try {
     validate_params(p);
