@@ -103,8 +103,11 @@ CheckpointLock::CheckpointLock(const std::string& checkpoint) {
       const ssize_t n = ::pread(fd, pid, sizeof pid - 1, 0);
       ::close(fd);
       if (err == EWOULDBLOCK) {
-        throw OutputError(checkpoint + ": the checkpoint is in use by another wavetrace process" +
-                          (n > 0 ? " (pid " + std::string(pid, static_cast<size_t>(n)) + ")" : std::string()) +
+        const std::string holder = n > 0 ? std::string(pid, static_cast<size_t>(n)) : std::string();
+        throw OutputError(checkpoint + ": the checkpoint is in use by another render" +
+                          (holder.empty()                            ? std::string()
+                           : holder == std::to_string(::getpid()) ? std::string(" of this process")
+                                                                  : " (wavetrace pid " + holder + ")") +
                           "; two renders cannot share one checkpoint");
       }
       throw OutputError(checkpoint + ": cannot lock the checkpoint (" + std::string(std::strerror(err)) + ")");
@@ -148,22 +151,27 @@ void CheckpointLock::release() noexcept {
 }
 
 std::string colliding_jobs(const std::vector<Job>& jobs, const std::vector<bool>& refused) {
-  std::map<std::string, std::pair<size_t, std::string>> writers;  // file -> (job, field)
+  // Every file a job writes, and every file it reads: a written file may be no other
+  // job's file at all (written, or read: a scene, a resume file); files only read
+  // may be shared. A job's own files are check_distinct_files's.
+  struct Use {
+    size_t job;
+    std::string field;
+    bool written;
+  };
+  std::map<std::string, std::vector<Use>> uses;  // file -> the jobs that use it, in order
   for (size_t i = 0; i < jobs.size(); ++i) {
     if (i < refused.size() && refused[i]) continue;
-    std::map<std::string, bool> own;  // a job's own files are check_distinct_files's
     for (const JobFile& f : job_files(jobs[i])) {
-      if (!f.written) continue;
-      const std::string key = file_key(f.path);
-      if (own.count(key)) continue;
-      own[key] = true;
-      auto [it, added] = writers.emplace(key, std::make_pair(i, f.field));
-      if (!added) {
-        return "jobs " + std::to_string(it->second.first + 1) + " and " + std::to_string(i + 1) +
-               " would write the same file " + f.path + " (the " + it->second.second + " of job " +
-               std::to_string(it->second.first + 1) + ", the " + f.field + " of job " + std::to_string(i + 1) +
-               "); the batch is refused before any job runs";
+      std::vector<Use>& u = uses[file_key(f.path)];
+      for (const Use& other : u) {
+        if (other.job == i || !(other.written || f.written)) continue;
+        const std::string a = std::to_string(other.job + 1), b = std::to_string(i + 1);
+        return "jobs " + a + " and " + b + " would " + (other.written && f.written ? "write" : "write and read") +
+               " the same file " + f.path + " (the " + other.field + " of job " + a + ", the " + f.field +
+               " of job " + b + "); the batch is refused before any job runs";
       }
+      u.push_back({i, f.field, f.written});
     }
   }
   return "";

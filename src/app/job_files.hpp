@@ -58,10 +58,11 @@ class CheckpointLock {
   int fd_ = -1;
 };
 
-// A batch's jobs that would write one file (their images, stats or checkpoints):
-// one line naming both jobs (1-based, as the batch numbers them) and the file for the
-// first such pair; empty where there is none. Jobs refused when they were read
-// (`refused`) take no part.
+// A batch's jobs that would write one file (their images, stats or checkpoints), or
+// of which one would write a file another reads (its scene, a resume file): one line
+// naming both jobs (1-based, as the batch numbers them) and the file for the first
+// such pair; empty where there is none. Jobs refused when they were read (`refused`)
+// take no part.
 std::string colliding_jobs(const std::vector<Job>& jobs, const std::vector<bool>& refused);
 
 }  // namespace wt::app

@@ -15,6 +15,7 @@ namespace {
 
 std::string size_text(uint64_t bytes) {
   char buf[64];
+  if (bytes < input::kMiB) return std::to_string(bytes) + " bytes";
   if (bytes >= input::kGiB) {
     std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(bytes) / input::kGiB);
   } else {
@@ -35,8 +36,12 @@ std::string not_regular(mode_t mode) {
 }
 
 std::string too_large(uint64_t bytes, const InputKind& kind) {
-  return "it holds " + size_text(bytes) + ", more than the " + size_text(kind.max_bytes) + " a " + kind.what +
-         " may hold";
+  std::string held = size_text(bytes), limit = size_text(kind.max_bytes);
+  if (held == limit) {  // rounded alike: the bytes themselves
+    held = std::to_string(bytes) + " bytes";
+    limit = std::to_string(kind.max_bytes) + " bytes";
+  }
+  return "it holds " + held + ", more than the " + limit + " a " + kind.what + " may hold";
 }
 
 InputFileError open_failure(const std::string& path, const InputKind& kind, int err) {
