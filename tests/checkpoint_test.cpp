@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "app/batch.hpp"
 #include "app/checkpoint.hpp"
@@ -217,6 +218,147 @@ TEST_F(CheckpointTest, AnExistingCheckpointOfAnotherRenderIsNeverOverwritten) {
       << o.message;
   EXPECT_EQ(bytes_of(path("c.ckpt")), before);
   EXPECT_FALSE(fs::exists(path("out.pfm")));
+}
+
+// ---- What a checkpoint holds ----
+
+// A checkpoint's bytes with its header's `from` replaced by `to`, the header's length
+// and the checksum made good: a file that only its contents can refuse.
+std::string with_header_text(const std::string& bytes, const std::string& from, const std::string& to) {
+  // Layout: magic (8), format (4), header length (4), header, float count and floats, CRC-32 (4).
+  uint32_t header_bytes = 0;
+  std::memcpy(&header_bytes, bytes.data() + 12, sizeof header_bytes);
+  std::string header = bytes.substr(16, header_bytes);
+  const std::string film = bytes.substr(16 + header_bytes, bytes.size() - 4 - (16 + header_bytes));
+  const size_t at = header.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " in " << header;
+  if (at == std::string::npos) return bytes;
+  header.replace(at, from.size(), to);
+  std::string out = bytes.substr(0, 12);
+  header_bytes = static_cast<uint32_t>(header.size());
+  out.append(reinterpret_cast<const char*>(&header_bytes), sizeof header_bytes);
+  out += header + film;
+  const uint32_t crc = static_cast<uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(out.data()), out.size()));
+  out.append(reinterpret_cast<const char*>(&crc), sizeof crc);
+  return out;
+}
+
+TEST_F(CheckpointTest, SamplesThatAreNotAWholeNumberAreRefused) {
+  write_checkpoint(path("c.ckpt"), sample_checkpoint());
+  const std::string bytes = bytes_of(path("c.ckpt"));
+  ASSERT_NO_THROW(read_checkpoint(path("c.ckpt")));
+  write_bytes(path("half.ckpt"), with_header_text(bytes, "\"samples\":5", "\"samples\":2.5"));
+  EXPECT_EQ(refusal(path("half.ckpt")), path("half.ckpt") + ": not a usable checkpoint: its samples is 2.5, not a whole number");
+  write_bytes(path("text.ckpt"), with_header_text(bytes, "\"samples\":5", "\"samples\":\"5\""));
+  EXPECT_EQ(refusal(path("text.ckpt")),
+            path("text.ckpt") + ": not a usable checkpoint: its samples is \"5\", not a whole number");
+  // The same edit that keeps a whole number is read: the crafting is sound.
+  write_bytes(path("four.ckpt"), with_header_text(bytes, "\"samples\":5", "\"samples\":4"));
+  EXPECT_EQ(read_checkpoint(path("four.ckpt")).samples, 4);
+}
+
+TEST_F(CheckpointTest, SamplesOutsideZeroToSppAreRefused) {
+  Checkpoint c = sample_checkpoint();  // 16 spp
+  c.samples = 17;
+  write_checkpoint(path("more.ckpt"), c);
+  EXPECT_EQ(refusal(path("more.ckpt")), path("more.ckpt") + ": not a usable checkpoint: its samples is 17, outside 0..16");
+  c.samples = -1;
+  write_checkpoint(path("less.ckpt"), c);
+  EXPECT_EQ(refusal(path("less.ckpt")), path("less.ckpt") + ": not a usable checkpoint: its samples is -1, outside 0..16");
+  for (int32_t ok : {0, 16}) {
+    c.samples = ok;
+    write_checkpoint(path("ok.ckpt"), c);
+    EXPECT_EQ(read_checkpoint(path("ok.ckpt")).samples, ok);
+  }
+}
+
+TEST_F(CheckpointTest, SettingsOutsideTheirRangesAreRefused) {
+  Checkpoint c = sample_checkpoint();
+  c.identity.params.spp = 0;
+  c.samples = 0;
+  write_checkpoint(path("spp.ckpt"), c);
+  EXPECT_EQ(refusal(path("spp.ckpt")), path("spp.ckpt") + ": not a usable checkpoint: its spp is 0, outside 1..1000000");
+  write_checkpoint(path("c.ckpt"), sample_checkpoint());
+  write_bytes(path("depth.ckpt"), with_header_text(bytes_of(path("c.ckpt")), "\"depth\":8", "\"depth\":8.5"));
+  EXPECT_EQ(refusal(path("depth.ckpt")), path("depth.ckpt") + ": not a usable checkpoint: its depth is 8.5, not a whole number");
+}
+
+TEST_F(CheckpointTest, AFilmOfAnotherSizeIsRefused) {
+  Checkpoint c = sample_checkpoint();  // 4 x 2
+  c.film.resize(21);
+  write_checkpoint(path("short.ckpt"), c);
+  EXPECT_EQ(refusal(path("short.ckpt")),
+            path("short.ckpt") + ": not a usable checkpoint: its film holds 21 values; a 4 x 2 render's holds 24");
+  c.film.assign(4 * 2 * 3 + 3, 0.0f);
+  write_checkpoint(path("long.ckpt"), c);
+  EXPECT_NE(refusal(path("long.ckpt")).find("its film holds 27 values; a 4 x 2 render's holds 24"), std::string::npos);
+}
+
+// A film of sums of radiance is finite and at least 0: a NaN, an infinity or a
+// negative value would go into every later sample's mean.
+TEST_F(CheckpointTest, AFilmWithANanAnInfinityOrANegativeValueIsRefused) {
+  Checkpoint c = sample_checkpoint();
+  c.film[7] = std::nanf("");  // pixel 2 of 8: (2, 0)
+  write_checkpoint(path("nan.ckpt"), c);
+  EXPECT_EQ(refusal(path("nan.ckpt")), path("nan.ckpt") + ": not a usable checkpoint: its film's pixel (2, 0) holds "
+                                                          "NaN; a sum of radiance is finite and at least 0");
+  c = sample_checkpoint();
+  c.film[23] = -1.0f;  // the last pixel: (3, 1)
+  write_checkpoint(path("negative.ckpt"), c);
+  const std::string negative = refusal(path("negative.ckpt"));
+  EXPECT_EQ(negative.rfind(path("negative.ckpt") + ": not a usable checkpoint: its film's pixel (3, 1) holds -1", 0), 0u)
+      << negative;
+  EXPECT_NE(negative.find("; a sum of radiance is finite and at least 0"), std::string::npos) << negative;
+  c = sample_checkpoint();
+  c.film[12] = std::numeric_limits<float>::infinity();  // pixel 4: (0, 1)
+  write_checkpoint(path("inf.ckpt"), c);
+  EXPECT_EQ(refusal(path("inf.ckpt")), path("inf.ckpt") + ": not a usable checkpoint: its film's pixel (0, 1) holds an "
+                                                          "infinity; a sum of radiance is finite and at least 0");
+}
+
+// A bad checkpoint resumed by a job: bad input, and the checkpoint left as it is.
+TEST_F(CheckpointTest, AJobResumingABadCheckpointIsBadInputAndKeepsIt) {
+  Checkpoint c = sample_checkpoint();
+  c.film[0] = std::nanf("");
+  write_checkpoint(path("bad.ckpt"), c);
+  const std::string before = bytes_of(path("bad.ckpt"));
+  Job j = job(path("out.pfm"));
+  j.resume = path("bad.ckpt");
+  const JobOutcome o = run_job(j);
+  EXPECT_EQ(o.exit_code, kExitBadInput);
+  EXPECT_NE(o.message.find(path("bad.ckpt") + ": not a usable checkpoint: its film's pixel (0, 0) holds NaN"),
+            std::string::npos)
+      << o.message;
+  EXPECT_EQ(bytes_of(path("bad.ckpt")), before);
+  EXPECT_FALSE(fs::exists(path("out.pfm")));
+}
+
+// Resumed with every sample done, the job renders nothing: its line says so, rather
+// than a rate of rays over 0 seconds ("-nan M rays/s").
+TEST_F(CheckpointTest, AFinishedCheckpointResumedSaysNothingWasLeftToRender) {
+  Checkpoint c = sample_checkpoint();
+  c.samples = c.identity.params.spp;
+  write_checkpoint(path("done.ckpt"), c);
+  Job j = job(path("done.pfm"));
+  const RenderParams& p = c.identity.params;
+  j.width = p.width;
+  j.height = p.height;
+  j.spp = p.spp;
+  j.depth = p.depth;
+  j.roulette_depth = p.roulette_depth;
+  j.seed = p.seed;
+  j.nee = p.nee;
+  j.resume = path("done.ckpt");
+  const JobOutcome o = run_job(j);
+  ASSERT_EQ(o.exit_code, 0) << o.message;
+  EXPECT_TRUE(fs::exists(path("done.pfm")));
+  EXPECT_EQ(o.resumed_from_sample, p.spp);
+  testing::internal::CaptureStderr();
+  print_outcome(j, o);
+  const std::string said = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(said, path("done.pfm") + ": every one of its 16 samples was in the checkpoint " + path("done.ckpt") +
+                      "; nothing was left to render\n");
+  EXPECT_EQ(said.find("nan"), std::string::npos) << said;
 }
 
 TEST_F(CheckpointTest, AResumedBatchSkipsTheJobsWhoseImageExists) {

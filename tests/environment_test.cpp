@@ -264,6 +264,19 @@ TEST(Environment, BadSettingsNameTheFieldAndTheFile) {
   EXPECT_NE(unknown.find("gamma"), std::string::npos) << unknown;
 }
 
+// The brightest texel times the intensity is the most radiance the sky gives: at most
+// 1e9, as every radiance of a scene.
+TEST(Environment, BrightestTexelTimesIntensityIsAtMostABillion) {
+  test::TestFolder folder;
+  const std::vector<float> rgb = {1000.0f, 1.0f, 1.0f, 0.5f, 0.5f, 0.5f};
+  ASSERT_TRUE(stbi_write_hdr((folder.root() / "sky.hdr").string().c_str(), 2, 1, 3, rgb.data()));
+  const std::string source = (folder.root() / "scene.json").string();
+  const std::string e = error_of(sky_scene(R"({"type": "environment", "file": "sky.hdr", "intensity": 1e7})"), source);
+  EXPECT_EQ(e.rfind(source + ": /sky/intensity: the environment's brightest texel (1000", 0), 0u) << e;
+  EXPECT_NE(e.find("is more than 1e9, the most radiance a scene may hold"), std::string::npos) << e;
+  EXPECT_EQ(error_of(sky_scene(R"({"type": "environment", "file": "sky.hdr", "intensity": 1e6})"), source), "");
+}
+
 // ---- Every kernel ----
 
 class EnvironmentRender : public testing::TestWithParam<Variant> {

@@ -3,6 +3,7 @@
 // ../shared/models where that folder is present.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -399,6 +400,151 @@ TEST_F(MeshLoad, GltfErrorsNameTheFileAndTheProblem) {
     "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/png"}], "samplers": [{})";
   expect_error(write("image.gltf", embedded_image.embedded()),
                "material 'material 0': base colour texture is embedded in the file (only image files are supported)");
+}
+
+// ---- OBJ numbers ----
+
+// tinyobjloader would take 'abc' for 0, keep NaN and the infinities, and wrap an index
+// past 2^31 to another vertex; each is refused with the file and the line.
+TEST_F(MeshLoad, ObjVertexNumbersMustBeFinite) {
+  expect_error(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "malformed OBJ: line 2: v: 'nan' is not a finite number");
+  expect_error(write("words.obj", "v abc def ghi\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "malformed OBJ: line 1: v: 'abc' is not a finite number");
+  expect_error(write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 -inf\nf 1 2 3\n"),
+               "malformed OBJ: line 3: v: '-inf' is not a finite number");
+  // Finite as a double, not as a float.
+  expect_error(write("huge.obj", "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "malformed OBJ: line 2: v: '1e39' is not a finite number");
+}
+
+TEST_F(MeshLoad, ObjNormalsAndTextureCoordinatesMustBeFinite) {
+  expect_error(write("vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan 0 1\nf 1//1 2//1 3//1\n"),
+               "malformed OBJ: line 4: vn: 'nan' is not a finite number");
+  expect_error(write("vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt inf 0\nf 1/1 2/1 3/1\n"),
+               "malformed OBJ: line 4: vt: 'inf' is not a finite number");
+}
+
+TEST_F(MeshLoad, ObjIndexPastTheVerticesIsRefusedNotWrapped) {
+  // 2^32 + 1 would wrap to 1 in 32 bits.
+  const std::string path = write("wrap.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967297\n");
+  expect_error(path, "malformed OBJ: line 4: index 4294967297 is out of range: the file has 3 vertex positions");
+  expect_error(write("normal.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n"),
+               "malformed OBJ: line 5: index 2 is out of range: the file has 1 normal");
+}
+
+TEST_F(MeshLoad, ObjNegativeIndexBeforeTheFirstVertexIsRefused) {
+  expect_error(write("negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n"),
+               "malformed OBJ: line 4: f: index -4 reaches before the first vertex position (3 given so far)");
+  // Relative indices count the vertices given before the face, not the file's.
+  expect_error(write("early.obj", "v 0 0 0\nf -1 -2 -3\nv 1 0 0\nv 0 1 0\n"),
+               "malformed OBJ: line 2: f: index -2 reaches before the first vertex position (1 given so far)");
+  // Within range they work.
+  EXPECT_EQ(load_mesh(write("relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n")).triangles.size(), 1u);
+}
+
+TEST_F(MeshLoad, ObjIndexZeroOrNotWholeIsRefused) {
+  expect_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"),
+               "malformed OBJ: line 4: f: '0' is not a corner of whole, non-zero indices");
+  expect_error(write("half.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2.5\n"),
+               "malformed OBJ: line 4: f: '2.5' is not a corner of whole, non-zero indices");
+}
+
+// A mesh's emission is bounded as a scene file's is (at most 1e9).
+TEST_F(MeshLoad, MeshEmissionIsAtMostABillion) {
+  write("hot.mtl", "newmtl hot\nKe 2e9 0 0\n");
+  expect_error(write("hot.obj", "mtllib hot.mtl\nusemtl hot\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+               "material 'hot': Ke must be 3 numbers in [0, 1e9] (the most radiance a scene may hold)");
+  TestGltf g = quad();
+  g.material = R"({"name": "sun", "emissiveFactor": [0, 2e9, 0]})";
+  expect_error(write("hot.gltf", g.embedded()),
+               "material 'sun': emissiveFactor must be 3 numbers in [0, 1e9] (the most radiance a scene may hold)");
+  g.material = R"({"name": "sun", "emissiveFactor": [0, 1e9, 0]})";  // the limit itself
+  EXPECT_EQ(load_mesh(write("bright.gltf", g.embedded())).materials[0].material.emission.y, 1e9f);
+}
+
+// ---- The glTF node graph ----
+
+// The quad's document with its scene's roots and its nodes replaced.
+std::string with_nodes(const std::string& gltf, const std::string& roots, const std::string& nodes) {
+  std::string out = gltf;
+  const std::string scenes = R"("scenes": [{"nodes": [0]}])", old_nodes = R"("nodes": [{"mesh": 0, "translation": [10, 20, 30]}])";
+  EXPECT_NE(out.find(scenes), std::string::npos);
+  EXPECT_NE(out.find(old_nodes), std::string::npos);
+  out.replace(out.find(scenes), scenes.size(), R"("scenes": [{"nodes": )" + roots + "}]");
+  out.replace(out.find(old_nodes), old_nodes.size(), R"("nodes": )" + nodes);
+  return out;
+}
+
+// The walk keeps its own stack: a chain far deeper than the call stack could hold loads.
+TEST_F(MeshLoad, GltfChainOfAHundredThousandNodesLoads) {
+  const int depth = 100001;
+  std::string nodes = "[";
+  for (int i = 0; i + 1 < depth; ++i) nodes += "{\"children\": [" + std::to_string(i + 1) + "]},";
+  nodes += R"({"mesh": 0, "translation": [10, 20, 30]}])";  // the deepest node holds the mesh
+  expect_quad(load_mesh(write("chain.gltf", with_nodes(quad().embedded(), "[0]", nodes))));
+}
+
+TEST_F(MeshLoad, GltfNodeWithTwoParentsIsRefused) {
+  const std::string path = write("shared.gltf", with_nodes(quad().embedded(), "[0, 1]",
+                                                           R"([{"children": [2]}, {"children": [2]}, {"mesh": 0}])"));
+  expect_error(path, "node 2 has two parents (nodes 0 and 1); glTF nodes form a forest, each node with one parent at most");
+}
+
+TEST_F(MeshLoad, GltfChildListedTwiceByOneParentIsRefused) {
+  const std::string path = write("twice.gltf", with_nodes(quad().embedded(), "[0]", R"([{"children": [1, 1]}, {"mesh": 0}])"));
+  expect_error(path, "node 1 is listed twice as a child of node 0; glTF nodes form a forest");
+}
+
+// 40 levels of two nodes, each the parent of both nodes below: walked as a tree it
+// would reach the mesh 2^40 times. Refused at once instead.
+TEST_F(MeshLoad, GltfDiamondOfFortyLevelsIsRefusedQuickly) {
+  test::Watchdog watchdog(std::chrono::seconds(30), "a glTF diamond of 40 levels");
+  const int levels = 40;
+  std::string nodes = "[";
+  for (int level = 0; level < levels; ++level) {
+    const std::string below = std::to_string(2 * level + 2) + ", " + std::to_string(2 * level + 3);
+    nodes += "{\"children\": [" + below + "]}, {\"children\": [" + below + "]}, ";
+  }
+  nodes += R"({"mesh": 0}, {"mesh": 0}])";
+  const auto start = std::chrono::steady_clock::now();
+  expect_error(write("diamond.gltf", with_nodes(quad().embedded(), "[0, 1]", nodes)),
+               "node 2 has two parents (nodes 0 and 1)");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+}
+
+TEST_F(MeshLoad, GltfCycleIsRefused) {
+  // A loop apart from the scene's root (no node in it has two parents).
+  expect_error(write("loop.gltf", with_nodes(quad().embedded(), "[0]", R"([{"mesh": 0}, {"children": [2]}, {"children": [1]}])")),
+               "the node hierarchy has a cycle through node 1");
+  expect_error(write("self.gltf", with_nodes(quad().embedded(), "[0]", R"([{"mesh": 0, "children": [0]}])")),
+               "the node hierarchy has a cycle through node 0");
+}
+
+TEST_F(MeshLoad, GltfSceneRootsMustBeRootsListedOnce) {
+  expect_error(write("root.gltf", with_nodes(quad().embedded(), "[0, 1]", R"([{"children": [1]}, {"mesh": 0}])")),
+               "node 1 is a root of the scene but a child of node 0");
+  expect_error(write("roots.gltf", with_nodes(quad().embedded(), "[0, 0]", R"([{"mesh": 0}])")),
+               "node 0 is listed twice among the scene's nodes");
+}
+
+// A primitive without "material" takes the specification's default: metallic 1,
+// roughness 1, base colour 1.
+TEST_F(MeshLoad, GltfPrimitiveWithoutAMaterialGetsTheDefaultMaterial) {
+  TestGltf g = quad();
+  g.material = "";  // "materials": []
+  std::string text = g.embedded();
+  const std::string from = R"(, "material": 0})";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(), "}");
+  const TriangleMesh m = load_mesh(write("nomaterial.gltf", text));
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].name, "default");
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Metal);
+  expect_vec(m.materials[0].material.albedo, vec3(1.0f));
+  EXPECT_FLOAT_EQ(m.materials[0].material.fuzz, 1.0f);
+  expect_vec(m.materials[0].material.emission, vec3(0.0f));
+  EXPECT_EQ(m.triangle_material, (std::vector<uint32_t>{0, 0}));
 }
 
 // ---- The real models of ../shared/models ----

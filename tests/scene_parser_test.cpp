@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -364,12 +365,35 @@ TEST(SceneParser, ColoursOutsideUnitIntervalAreRejected) {
   expect_error(with(doc, "/textures/1/high/2", 2), "/textures/1/high/2", "must be in [0, 1] (got 2)");
 }
 
-TEST(SceneParser, EmissionAndSkyMustBeNonNegativeButAreUnbounded) {
+TEST(SceneParser, EmissionAndSkyMustBeNonNegative) {
   json doc = base_scene();
   expect_error(with(doc, "/materials/4/emission/2", -1), "/materials/4/emission/2", "must be >= 0 (got -1)");
   expect_error(with(doc, "/sky/horizon/0", -0.1), "/sky/horizon/0", "must be >= 0 (got -0.1)");
   Scene s = parse_scene(with(doc, "/materials/4/emission", {50, 0, 1000}).dump(), kSource);
   EXPECT_EQ(material_named(s, "lamp").emission, vec3(50, 0, 1000));
+}
+
+// Radiance past 1e9 would overflow the film's float sums after a few samples.
+TEST(SceneParser, EmissionAndSkyRadianceAreAtMostABillion) {
+  json doc = base_scene();
+  expect_error(with(doc, "/materials/4/emission/1", 3e38), "/materials/4/emission/1",
+               "must be at most 1e9, the most radiance a scene may hold (got 3e+38)");
+  expect_error(with(doc, "/sky/zenith/2", 1.5e9), "/sky/zenith/2", "must be at most 1e9, the most radiance a scene may hold");
+  json uniform = with(doc, "/sky", json::parse(R"({"type": "uniform", "radiance": [1, 1e10, 1]})"));
+  expect_error(uniform, "/sky/radiance/1", "must be at most 1e9");
+  Scene s = parse_scene(with(doc, "/materials/4/emission", {1e9, 0, 1}).dump(), kSource);  // the limit itself
+  EXPECT_EQ(material_named(s, "lamp").emission.x, 1e9f);
+}
+
+// Coordinates past 1e15 lose every digit of a scene's detail in float.
+TEST(SceneParser, CoordinatesAndRadiiAreWithinAQuadrillion) {
+  json doc = base_scene();
+  expect_error(with(doc, "/spheres/1/center/0", 1e20), "/spheres/1/center/0",
+               "must be within +-1e15, the largest coordinate a scene may hold (got 1e+20)");
+  expect_error(with(doc, "/spheres/1/center/2", -1e20), "/spheres/1/center/2", "must be within +-1e15");
+  expect_error(with(doc, "/spheres/0/radius", 1e20), "/spheres/0/radius", "must be at most 1e15");
+  expect_error(with(doc, "/camera/look_from/1", 1e20), "/camera/look_from/1", "must be within +-1e15");
+  expect_error(with(doc, "/camera/look_at/0", -1e16), "/camera/look_at/0", "must be within +-1e15");
 }
 
 TEST(SceneParser, UnknownMaterialReferenceIsRejected) {
@@ -465,6 +489,63 @@ TEST(SceneParser, UnreadableTextureIsReported) {
     std::string message = e.what();
     expect_error(message, "/textures/2/file", "cannot read image '" + dir.path() + "/corrupt.png' (", corrupt);
     EXPECT_EQ(message.find("()"), std::string::npos) << "stb's reason is missing: " << message;
+  }
+}
+
+// An image texture that is no image file: each says what it is instead.
+TEST(SceneParser, TextureThatIsADirectorySaysSo) {
+  TempDir dir;
+  fs::create_directories(fs::path(dir.path()) / "folder.png");
+  const std::string scene = dir.write("s.json", image_texture_scene("folder.png", "srgb").dump());
+  try {
+    load_scene(scene);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), scene + ": /textures/2/file: cannot read image '" + dir.path() +
+                                         "/folder.png' (it is a directory, not a file)");
+  }
+}
+
+TEST(SceneParser, TextureThatIsALoopOfLinksSaysSo) {
+  TempDir dir;
+  const fs::path a = fs::path(dir.path()) / "a.png", b = fs::path(dir.path()) / "b.png";
+  fs::create_symlink(b, a);
+  fs::create_symlink(a, b);
+  const std::string scene = dir.write("s.json", image_texture_scene("a.png", "srgb").dump());
+  try {
+    load_scene(scene);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()), scene + ": /textures/2/file: cannot read image '" + a.string() +
+                                         "' (cannot open it (a loop of symbolic links))");
+  }
+}
+
+// A PNG cut short (a copy interrupted): the message says the file ends early, not
+// only the decoder's word for it.
+TEST(SceneParser, TruncatedPngTextureSaysItIsCutShort) {
+  TempDir dir;
+  std::vector<unsigned char> pixels(32 * 32 * 4);
+  uint32_t state = 12345;
+  for (unsigned char& p : pixels) {
+    state = state * 1664525u + 1013904223u;  // noise, so that the compressed data is not a few bytes
+    p = static_cast<unsigned char>(state >> 24);
+  }
+  const std::string whole = dir.write_png("whole.png", 32, 32, pixels);
+  std::ifstream in(whole, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1000u);
+  EXPECT_NO_THROW(load_scene(dir.write("whole.json", image_texture_scene("whole.png", "srgb").dump())));
+  dir.write("cut.png", bytes.substr(0, bytes.size() / 2));
+  const std::string scene = dir.write("s.json", image_texture_scene("cut.png", "srgb").dump());
+  try {
+    load_scene(scene);
+    ADD_FAILURE() << "no error";
+  } catch (const SceneError& e) {
+    const std::string message = e.what();
+    expect_error(message, "/textures/2/file",
+                 "cannot read image '" + dir.path() + "/cut.png' (the file is cut short: it ends before its image does (",
+                 scene);
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -109,6 +110,26 @@ bool limit_file_size(unsigned long long bytes) {
   std::signal(SIGXFSZ, SIG_IGN);
   const rlimit r{static_cast<rlim_t>(bytes), static_cast<rlim_t>(bytes)};
   return ::setrlimit(RLIMIT_FSIZE, &r) == 0;
+}
+
+Watchdog::Watchdog(std::chrono::seconds limit, std::string what) {
+  thread_ = std::thread([this, limit, what = std::move(what)] {
+    std::unique_lock<std::mutex> lock(m_);
+    if (cv_.wait_for(lock, limit, [this] { return done_; })) return;
+    std::fprintf(stderr, "watchdog: %s did not finish within %lld s; the test process is ended (exit 124)\n",
+                 what.c_str(), static_cast<long long>(limit.count()));
+    std::fflush(stderr);
+    std::_Exit(124);
+  });
+}
+
+Watchdog::~Watchdog() {
+  {
+    std::lock_guard<std::mutex> lock(m_);
+    done_ = true;
+  }
+  cv_.notify_all();
+  thread_.join();
 }
 
 }  // namespace wt::test

@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace wt::test {
@@ -62,6 +66,24 @@ std::string in_child_process(const std::function<std::string()>& fn);
 // past `bytes` (RLIMIT_FSIZE) and SIGXFSZ is ignored, so a write past the limit fails
 // with EFBIG, as a write to a full disk fails with ENOSPC. False if it cannot be set.
 bool limit_file_size(unsigned long long bytes);
+
+// A guard on a test that could hang (a read that blocks on a FIFO): unless it is
+// destroyed within `limit`, its thread prints what hung and ends the process with
+// exit code 124 (as timeout(1) does), so that a regression fails the test run
+// instead of holding CI until its own time limit.
+class Watchdog {
+ public:
+  Watchdog(std::chrono::seconds limit, std::string what);
+  ~Watchdog();
+  Watchdog(const Watchdog&) = delete;
+  Watchdog& operator=(const Watchdog&) = delete;
+
+ private:
+  std::mutex m_;
+  std::condition_variable cv_;
+  bool done_ = false;
+  std::thread thread_;
+};
 
 }  // namespace wt::test
 

@@ -1,11 +1,15 @@
 // `wavetrace batch` through the built program (its path is this binary's first
 // argument; see CMakeLists.txt): good and bad jobs, in the lane's worker process and
-// each in a process of its own, on the CPU, and on CUDA where a device is present.
+// each in a process of its own, on the CPU, and on CUDA where a device is present;
+// jobs that would write one file, inputs that are no jobs file, and (through
+// `wavetrace render`) a FIFO for a scene and a disk that fills up.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -36,10 +40,15 @@ class BatchCommand : public testing::Test {
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
 
   // Runs `wavetrace batch ARGS` with its temporary files in dir_/tmp; its exit code.
-  int batch(const std::string& args) {
+  int batch(const std::string& args) { return wavetrace("batch " + args); }
+
+  // Runs `wavetrace WORDS` with its temporary files in dir_/tmp, after `setup` (shell
+  // commands, such as a ulimit, in the same subshell) and through `wrapper` (a command
+  // that runs it, such as timeout): its exit code, its output and errors in out_ and err_.
+  int wavetrace(const std::string& words, const std::string& setup = "", const std::string& wrapper = "") {
     fs::create_directories(dir_ / "tmp");
-    const std::string command = "TMPDIR='" + path("tmp") + "' '" + g_wavetrace + "' batch " + args + " >'" +
-                                path("out.txt") + "' 2>'" + path("err.txt") + "'";
+    const std::string command = "(export TMPDIR='" + path("tmp") + "'; " + setup + "exec " + wrapper + "'" +
+                                g_wavetrace + "' " + words + ") >'" + path("out.txt") + "' 2>'" + path("err.txt") + "'";
     const int status = std::system(command.c_str());
     out_ = read(path("out.txt"));
     err_ = read(path("err.txt"));
@@ -131,6 +140,130 @@ TEST_F(BatchCommand, AWorkerStartedByHandSaysWhatItIs) {
   EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 1);
   EXPECT_NE(read(path("err.txt")).find("wavetrace: worker: descriptor 3 is not open for answers"), std::string::npos)
       << read(path("err.txt"));
+}
+
+// ---- Files that collide, inputs that are no jobs file ----
+
+const std::string kPrecious = "bytes that were here before the batch";
+
+// Two jobs writing one image: the second would overwrite the first's. Refused before
+// either runs, naming both.
+TEST_F(BatchCommand, TwoJobsWritingOneImageAreRefusedBeforeAnyRuns) {
+  std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "width": 32, "height": 16, "spp": 2},
+    "jobs": [{"scene": "s.json", "output": "a.png"}, {"scene": "s.json", "output": "b.png"},
+             {"scene": "s.json", "output": "alias/a.png", "seed": 2}]})";
+  fs::create_directory_symlink(dir_, path("alias"));  // another name for the folder
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 2) << err_;
+  EXPECT_NE(err_.find("wavetrace: jobs 1 and 3 would write the same file " + path("alias/a.png") +
+                      " (the output of job 1, the output of job 3); the batch is refused before any job runs"),
+            std::string::npos)
+      << err_;
+  EXPECT_FALSE(fs::exists(path("a.png")));
+  EXPECT_FALSE(fs::exists(path("b.png")));  // no job ran, not even the good one
+}
+
+// Scene files given directly are rendered to --output-dir by their stems: two of one stem collide.
+TEST_F(BatchCommand, ScenesOfOneStemIntoOneFolderAreRefused) {
+  for (const char* sub : {"a", "b", "out"}) fs::create_directories(dir_ / sub);
+  fs::copy_file(path("s.json"), path("a/x.json"));
+  fs::copy_file(path("s.json"), path("b/x.json"));
+  EXPECT_EQ(batch("'" + path("a/x.json") + "' '" + path("b/x.json") + "' --output-dir '" + path("out") +
+                  "' --backend cpu --width 32 --height 16 --spp 2"),
+            2)
+      << err_;
+  EXPECT_NE(err_.find("jobs 1 and 2 would write the same file " + path("out/x.png")), std::string::npos) << err_;
+  EXPECT_TRUE(fs::is_empty(path("out")));
+}
+
+// A key given twice in one job: that job fails (which of the two was meant is not
+// known), the others run.
+TEST_F(BatchCommand, ARepeatedKeyFailsItsJobAlone) {
+  std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "width": 32, "height": 16, "spp": 2},
+    "jobs": [{"scene": "s.json", "output": "a.png", "seed": 1, "seed": 2}, {"scene": "s.json", "output": "b.png"}]})";
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 1) << err_;
+  EXPECT_FALSE(fs::exists(path("a.png")));
+  EXPECT_TRUE(fs::exists(path("b.png")));
+  EXPECT_EQ(count(out_, "FAILED: " + path("jobs.json") + ": /jobs/0/seed: duplicate key"), 1u) << out_;
+  EXPECT_EQ(count(out_, "ok -> " + path("b.png")), 1u) << out_;
+  EXPECT_NE(out_.find("\n2 jobs: 1 ok, 1 failed\n"), std::string::npos) << out_;
+}
+
+// A job whose checkpoint is its own image fails alone (the batch's other jobs do not
+// share its files), and the file that was there is kept.
+TEST_F(BatchCommand, AJobWhoseCheckpointIsItsImageFailsAlone) {
+  std::ofstream(path("b.pfm")) << kPrecious;
+  std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "width": 32, "height": 16, "spp": 2},
+    "jobs": [{"scene": "s.json", "output": "b.pfm", "checkpoint": "b.pfm"}, {"scene": "s.json", "output": "c.png"}]})";
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 1) << err_;
+  EXPECT_TRUE(fs::exists(path("c.png")));
+  EXPECT_EQ(read(path("b.pfm")), kPrecious);
+  EXPECT_EQ(count(out_, "FAILED: " + path("b.pfm") + ": output and checkpoint name the same file"), 1u) << out_;
+  EXPECT_FALSE(fs::exists(path("b.pfm.lock")));
+}
+
+TEST_F(BatchCommand, AFolderOrAMissingFileAsItsInputIsBadInput) {
+  fs::create_directories(dir_ / "jobs");
+  EXPECT_EQ(batch("'" + path("jobs") + "'"), 2) << err_;
+  EXPECT_EQ(err_, "wavetrace: " + path("jobs") + ": cannot read jobs file or scene file: it is a directory, not a file\n");
+  EXPECT_EQ(batch("'" + path("missing.json") + "'"), 2) << err_;
+  EXPECT_EQ(err_, "wavetrace: " + path("missing.json") + ": cannot open jobs file or scene file (No such file or "
+                                                         "directory)\n");
+}
+
+// Not a hang: the FIFO is refused without waiting for a writer (timeout(1) ends the
+// command should it wait, and the watchdog this test).
+TEST_F(BatchCommand, AFifoAsItsInputIsBadInputAtOnce) {
+  wt::test::Watchdog watchdog(std::chrono::seconds(60), "wavetrace batch FIFO");
+  ASSERT_EQ(::mkfifo(path("jobs.json").c_str(), 0600), 0);
+  EXPECT_EQ(wavetrace("batch '" + path("jobs.json") + "'", "", "timeout 30 "), 2) << err_;
+  EXPECT_NE(err_.find(path("jobs.json") + ": cannot read jobs file or scene file: it is a FIFO (named pipe)"),
+            std::string::npos)
+      << err_;
+}
+
+TEST_F(BatchCommand, ARenderOfAFifoSceneIsBadInputAtOnce) {
+  wt::test::Watchdog watchdog(std::chrono::seconds(60), "wavetrace render FIFO");
+  ASSERT_EQ(::mkfifo(path("fifo.json").c_str(), 0600), 0);
+  EXPECT_EQ(wavetrace("render '" + path("fifo.json") + "' -o '" + path("x.png") + "' --backend cpu -q", "",
+                      "timeout 30 "),
+            2)
+      << err_;
+  EXPECT_EQ(err_, "wavetrace: " + path("fifo.json") + ": cannot read scene file: it is a FIFO (named pipe), not a "
+                                                      "regular file\n");
+  EXPECT_FALSE(fs::exists(path("x.png")));
+}
+
+TEST_F(BatchCommand, AJobsFileWithDefaultsButNoJobsIsBadInput) {
+  std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "spp": 2}})";
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 2) << err_;
+  EXPECT_EQ(err_, "wavetrace: " + path("jobs.json") +
+                      ": /jobs: required key is missing (a jobs file lists its jobs under \"jobs\")\n");
+  // Neither a jobs file nor a scene.
+  std::ofstream(path("other.json")) << R"({"job": []})";
+  EXPECT_EQ(batch("'" + path("other.json") + "'"), 2) << err_;
+  EXPECT_NE(err_.find(path("other.json") + ": neither a jobs file nor a scene file"), std::string::npos) << err_;
+}
+
+TEST_F(BatchCommand, AnUnknownCommandIsNamedWithTheCommands) {
+  EXPECT_EQ(wavetrace("frobnicate"), 2);
+  EXPECT_EQ(err_, "wavetrace: unknown command 'frobnicate' (the commands: render, batch, bench, kernels)\n");
+  EXPECT_EQ(out_, "");
+}
+
+// A disk that fills up, for real: files of the command may not grow past one block
+// (ulimit -f). The image's write fails with EFBIG, said in one line (SIGXFSZ, which
+// would kill the process, is ignored), and no part of the image is left behind.
+TEST_F(BatchCommand, ARenderPastTheFileSizeLimitFailsAndLeavesNoFile) {
+  EXPECT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("big.pfm") +
+                          "' --backend cpu --width 32 --height 16 --spp 2 -q",
+                      "ulimit -f 1; "),
+            1)
+      << err_;
+  EXPECT_NE(err_.find(path("big.pfm") + ": cannot write (File too large)"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(path("big.pfm")));
+  for (const auto& e : fs::directory_iterator(dir_)) {
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+  }
 }
 
 }  // namespace
