@@ -2,6 +2,7 @@
 // transport that every backend and kernel runs.
 #pragma once
 
+#include "wavetrace/scene_lights.hpp"
 #include "wavetrace/scene_view.hpp"
 
 namespace wt {
@@ -33,49 +34,6 @@ WT_HD WT_INLINE bool occluded(const Scene& scene, const Ray& ray, float tmax) {
   return !intersect_closest<Kinds, true>(scene, ray, tmax).missed();
 }
 
-// A triangle of an instance, in world space.
-WT_HD WT_INLINE void world_triangle(const TriangleGeom& t, const Instance& in, vec3& a, vec3& b, vec3& c) {
-  a = t.corner(0);
-  b = t.corner(1);
-  c = t.corner(2);
-  if (!in.identity) {
-    a = in.world_from_object.point(a);
-    b = in.world_from_object.point(b);
-    c = in.world_from_object.point(c);
-  }
-}
-
-// Emitter (instance, prim)'s shape in world space (spheres are placed untransformed).
-template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE EmitterShape emitter_shape(const Scene& scene, int instance, int prim) {
-  if (spheres_only(Kinds) || scene.instance(instance).kind == PrimitiveKind::Sphere) {
-    const SphereGeom sg = scene.sphere(prim);
-    return EmitterShape::of_sphere(vec3(sg.x, sg.y, sg.z), sg.w);
-  }
-  vec3 a, b, c;
-  world_triangle(scene.triangle(prim), scene.instance(instance), a, b, c);
-  return EmitterShape::of_triangle(a, b, c);
-}
-
-// The density per solid angle with which light sampling from `from` draws the
-// direction `dir` (unit) that meets the emitter of this emission and shape at
-// distance `dist`: the probability of picking it by power (the host's table holds
-// the same light_power_of) times the shape's own density. Evaluated the same way for
-// a light sample and for a path that hits the emitter, so that the two MIS weights
-// of a direction sum to one.
-template <class Scene>
-WT_HD WT_INLINE float light_density(const Scene& scene, const vec3& emission, const EmitterShape& shape,
-                                    const vec3& from, const vec3& dir, float dist) {
-  const float pdf = shape.pdf(from, dir, dist);
-  return pdf > 0.0f ? light_power_of(emission, shape.area()) / scene.total_light_power() * pdf : 0.0f;
-}
-
-// The same for the sky (when it is sampled) and the direction `dir`.
-template <class Scene>
-WT_HD WT_INLINE float sky_light_density(const Scene& scene, const vec3& dir) {
-  return scene.sky_light_pick() * sky_direction_pdf(scene.sky, scene.environment_table(), dir);
-}
-
 // What a path adds that leaves the scene along `dir` (unit): the sky's radiance,
 // weighted against light sampling where the sky is a sampled light and the path's
 // last bounce (of BSDF density `pdf`; 0 after a specular bounce or the camera)
@@ -86,23 +44,6 @@ WT_HD WT_INLINE vec3 sky_seen(const Scene& scene, const RenderParams& rp, const 
   const vec3 sky = scene.sky.radiance(dir, scene.image_array());
   if ((Kinds & kLightSampling) == 0 || !(pdf > 0.0f) || rp.nee == 0 || !(scene.sky_light_pick() > 0.0f)) return sky;
   return sky * power_heuristic(pdf, sky_light_density(scene, dir));
-}
-
-// The emitter that u (in [0, 1)) picks from the scene's table, and the probability
-// of picking it.
-template <class Scene>
-WT_HD WT_INLINE int pick_light(const Scene& scene, float u, float& probability) {
-  int lo = 0, hi = scene.light_count() - 1;
-  while (lo < hi) {
-    const int mid = (lo + hi) / 2;
-    if (u < scene.light_cdf_at(mid)) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  probability = scene.light_cdf_at(lo) - (lo > 0 ? scene.light_cdf_at(lo - 1) : 0.0f);
-  return lo;
 }
 
 // A light sample's contribution, waiting for its shadow ray: added to the film

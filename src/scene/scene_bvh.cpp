@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "scene/scene.hpp"
-#include "wavetrace/path.hpp"
+#include "wavetrace/scene_lights.hpp"
 
 namespace wt {
 
@@ -210,7 +210,7 @@ float sky_light_power(const Scene& scene) {
 // The lights of the built instances (instance_mesh[i]: instance i's mesh, or
 // kSpheres) and the sky, with the table that picks them by power. An emitter's
 // power is computed in float from its world-space shape as the shading code
-// computes it (path.hpp, light_density), so that both see the same probabilities.
+// computes it (scene_lights.hpp, light_density), so that both see the same probabilities.
 void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
   scene.lights.clear();
   scene.light_cdf.clear();

@@ -245,4 +245,16 @@ WT_HD WT_INLINE SurfacePoint surface_at(const Geometry& g, const Ray& ray, const
   return sphere_surface(g.sphere(hit.prim), ray, hit.t);
 }
 
+// A triangle of an instance, in world space.
+WT_HD WT_INLINE void world_triangle(const TriangleGeom& t, const Instance& in, vec3& a, vec3& b, vec3& c) {
+  a = t.corner(0);
+  b = t.corner(1);
+  c = t.corner(2);
+  if (!in.identity) {
+    a = in.world_from_object.point(a);
+    b = in.world_from_object.point(b);
+    c = in.world_from_object.point(c);
+  }
+}
+
 }  // namespace wt
