@@ -1,7 +1,7 @@
 // Triangle meshes from Wavefront OBJ (+ MTL, through tinyobjloader) and glTF 2.0
 // (.gltf, .glb, through tinygltf), read into host arrays with their materials mapped
-// onto wavetrace's (docs/scene-format.md, "Meshes"). Scene files cannot place meshes
-// yet: this is the loading half of issue 7.
+// onto wavetrace's (docs/scene-format.md, "Meshes"). A scene file's `meshes` name the
+// files and its `instances` place them (scene_meshes.cpp).
 #pragma once
 
 #include <array>
