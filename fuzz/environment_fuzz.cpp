@@ -2,7 +2,7 @@
 // picks the format (even: Radiance .hdr through stb; odd: OpenEXR through
 // OpenEXR), the rest becomes the file a scene's environment sky names, read by the
 // scene reader (the format's loader, then the check that every value is finite
-// radiance). A SceneError is a clean rejection.
+// radiance). A InputError is a clean rejection.
 #include <ImathBox.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
@@ -14,6 +14,7 @@
 #include <string>
 
 #include "fuzz_support.hpp"
+#include "errors/errors.hpp"
 #include "scene/scene.hpp"
 
 namespace {
@@ -56,7 +57,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})";
   try {
     wt::parse_scene(scene, wt::fuzz::temp_dir() + "/scene.json");
-  } catch (const wt::SceneError&) {
+  } catch (const wt::InputError&) {
   }
   return 0;
 }

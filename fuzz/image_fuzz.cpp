@@ -1,6 +1,6 @@
 // The image loading path as a scene file drives it: the input becomes the file of
 // an image texture, read by the scene reader (stb, then the conversion to linear
-// floats). A SceneError (an unreadable image) is a clean rejection.
+// floats). A InputError (an unreadable image) is a clean rejection.
 #include <stb/stb_image.h>
 
 #include <cstddef>
@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fuzz_support.hpp"
+#include "errors/errors.hpp"
 #include "scene/scene.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -27,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})";
   try {
     wt::parse_scene(scene, wt::fuzz::temp_dir() + "/scene.json");
-  } catch (const wt::SceneError&) {
+  } catch (const wt::InputError&) {
   }
   return 0;
 }

@@ -2,12 +2,13 @@
 // becomes a mesh file, read through tinyobjloader (OBJ, with an MTL beside it) or
 // tinygltf (.gltf, .glb) and checked by the project's own code. The first byte picks
 // the format; for OBJ, the bytes after a "\0MTL\0" marker become the file m.mtl. A
-// SceneError is a clean rejection.
+// InputError is a clean rejection.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
 #include "fuzz_support.hpp"
+#include "errors/errors.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
 
@@ -27,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string path = wt::fuzz::write_input(name, reinterpret_cast<const uint8_t*>(mesh.data()), mesh.size());
   try {
     wt::load_mesh(path);
-  } catch (const wt::SceneError&) {
+  } catch (const wt::InputError&) {
   }
   return 0;
 }

@@ -22,6 +22,7 @@
 #include "app/batch.hpp"
 #include "app/cli.hpp"
 #include "app/process.hpp"
+#include "errors/errors.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -218,7 +219,7 @@ TEST(BatchLanes, ADeviceEachOrAShareOfThemEach) {
   EXPECT_EQ(batch_lanes("all", "cuda", 5, 1), (std::vector<std::string>{""}));
   EXPECT_EQ(batch_lanes("all", "cpu", 5, 2), (std::vector<std::string>{""}));
   EXPECT_EQ(batch_lanes("all", "auto", 5, 0), (std::vector<std::string>{""}));
-  EXPECT_THROW(batch_lanes("0,7", "cuda", 5, 2), SceneError);
+  EXPECT_THROW(batch_lanes("0,7", "cuda", 5, 2), InputError);
 }
 
 TEST_F(BatchProcessTest, ResumeSkipsJobsWhoseImageExists) {

@@ -15,6 +15,7 @@
 #include "app/batch.hpp"
 #include "app/checkpoint.hpp"
 #include "app/job.hpp"
+#include "errors/errors.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -50,7 +51,7 @@ class CheckpointTest : public testing::Test {
   std::string refusal(const std::string& file) const {
     try {
       read_checkpoint(file);
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       return e.what();
     }
     return "no error";
@@ -124,7 +125,7 @@ TEST_F(CheckpointTest, AnotherSceneSettingsOrKernelIsRefused) {
   auto refusal_of = [&](const CheckpointIdentity& now) {
     try {
       require_same_render("c.ckpt", then, now);
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       return std::string(e.what());
     }
     return std::string("no error");

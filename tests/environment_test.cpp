@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "image/image_io.hpp"
+#include "errors/errors.hpp"
 #include "render_support.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
@@ -158,7 +159,7 @@ std::string sky_scene(const std::string& sky) {
 std::string error_of(const std::string& json, const std::string& source) {
   try {
     parse_scene(json, source);
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "";

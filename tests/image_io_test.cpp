@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "exr_support.hpp"
+#include "errors/errors.hpp"
 #include "image/image_io.hpp"
 #include "test_support.hpp"
 #include "wavetrace/film.hpp"

@@ -26,6 +26,7 @@
 #include "app/bench.hpp"
 #include "app/checkpoint.hpp"
 #include "app/job.hpp"
+#include "errors/errors.hpp"
 #include "scene/input_file.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
@@ -102,8 +103,8 @@ TEST_F(InputFile, AMissingFileCannotBeOpened) {
   const Refusal r = refusal(path("missing"));
   EXPECT_EQ(r.line, path("missing") + ": cannot open test file (No such file or directory)");
   EXPECT_EQ(r.reason, "cannot open it (No such file or directory)");
-  // An InputFileError is a SceneError: every caller's bad-input handling takes it.
-  EXPECT_THROW(read_input_file(path("missing"), kTestFile), SceneError);
+  // An InputFileError is a InputError: every caller's bad-input handling takes it.
+  EXPECT_THROW(read_input_file(path("missing"), kTestFile), InputError);
 }
 
 TEST_F(InputFile, ADirectoryIsRefused) {
@@ -204,7 +205,7 @@ TEST(Watchdog, OneDestroyedInTimeEndsNothing) {
 
 enum class Bad { Fifo, Directory };
 
-// A reader's refusal: exit code 2 with its line (a SceneError, or a job's bad input),
+// A reader's refusal: exit code 2 with its line (a InputError, or a job's bad input),
 // 0 where it did not refuse, or another code with what happened.
 struct Outcome {
   int code = 0;
@@ -215,10 +216,10 @@ template <class F>
 Outcome outcome_of(F&& read) {
   try {
     read();
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     return {app::kExitBadInput, e.what()};
   } catch (const std::exception& e) {
-    return {99, std::string("not a SceneError: ") + e.what()};
+    return {99, std::string("not a InputError: ") + e.what()};
   }
   return {0, "no error"};
 }

@@ -22,6 +22,7 @@
 #include "app/checkpoint.hpp"
 #include "app/job.hpp"
 #include "app/job_files.hpp"
+#include "errors/errors.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {

@@ -15,6 +15,7 @@
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
+#include "errors/errors.hpp"
 #include "exr_support.hpp"
 #include "test_support.hpp"
 
@@ -258,7 +259,7 @@ TEST_F(JobTest, OutOfHostMemoryFailsOnlyThatJob) {
 
 TEST_F(JobTest, MalformedJobsFileIsRejected) {
   std::string jobs = write("jobs.json", R"({"jobs": [)");
-  EXPECT_THROW(read_jobs_file(jobs, Job{}), SceneError);
+  EXPECT_THROW(read_jobs_file(jobs, Job{}), InputError);
 }
 
 // What a reader threw, or "" when it did not.
@@ -266,7 +267,7 @@ template <class F>
 std::string error_of(F&& read) {
   try {
     read();
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "";

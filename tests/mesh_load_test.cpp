@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "scene/mesh_load.hpp"
+#include "errors/errors.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
 
@@ -32,12 +33,12 @@ class MeshLoad : public ::testing::Test {
     return path;
   }
 
-  // load_mesh must throw a SceneError that starts with the file and contains `what`.
+  // load_mesh must throw a InputError that starts with the file and contains `what`.
   void expect_error(const std::string& path, const std::string& what) {
     try {
       load_mesh(path);
       ADD_FAILURE() << path << " loaded; expected: " << what;
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       std::string message = e.what();
       EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
       EXPECT_NE(message.find(what), std::string::npos) << message;

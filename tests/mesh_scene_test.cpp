@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "app/job.hpp"
+#include "errors/errors.hpp"
 #include "mesh_support.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
@@ -47,7 +48,7 @@ class MeshScene : public testing::Test {
     try {
       load_scene(scene);
       ADD_FAILURE() << scene << " loaded";
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       const std::string message = e.what();
       EXPECT_EQ(message.rfind(file + ": ", 0), 0u) << message;
       EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "cuda/cuda_backend.hpp"
+#include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
 #include "render/renderer.hpp"
@@ -264,12 +265,12 @@ TEST(BackendAgreement, CudaMatchesCpuForEachKernel) {
 
 TEST(RenderSettings, RejectsZeroSamples) {
   RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, 8, 8, 0, 4, 4, 1);
-  EXPECT_THROW(render(furnace_scene(), o), SceneError);
+  EXPECT_THROW(render(furnace_scene(), o), InputError);
 }
 
 TEST(RenderSettings, ConstantMegakernelNeedsCuda) {
   RenderOptions o = options_for(Backend::Cpu, Kernel::MegakernelConstant, 8, 8, 1, 4, 4, 1);
-  EXPECT_THROW(render(furnace_scene(), o), SceneError);
+  EXPECT_THROW(render(furnace_scene(), o), InputError);
 }
 
 TEST(RenderSettings, SceneBeyondConstantMemoryIsRefusedByTheConstantMegakernel) {
@@ -287,7 +288,7 @@ TEST(RenderSettings, SceneBeyondConstantMemoryIsRefusedByTheConstantMegakernel) 
   try {
     render(scene, o);
     FAIL() << "a scene of 4000 spheres was put in constant memory";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("big.json"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find(std::to_string(cuda::constant_scene_capacity())), std::string::npos)
         << e.what();
@@ -303,7 +304,7 @@ TEST(RenderSettings, RenderThatCannotFitDeviceMemoryIsRefusedWithSizes) {
   try {
     cuda::require_device_memory(p, need, size_t(1) << 30, "Test GPU");
     FAIL() << "a 3 GiB film was accepted on a device with 1 GiB free";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("16384 x 16384"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("Test GPU"), std::string::npos) << e.what();
   }

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "errors/errors.hpp"
 #include "scene/scene.hpp"
 
 namespace wt {
@@ -51,7 +52,7 @@ TEST(BigScene, RepeatedKeyDeepInABigSceneNamesItsPath) {
   try {
     parse_scene(spheres_scene(50000, 45678), "big.json");
     FAIL() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "big.json: /spheres/45678/radius: duplicate key");
   }
 }

@@ -11,6 +11,7 @@
 #include <set>
 
 #include "scene/scene.hpp"
+#include "errors/errors.hpp"
 #include "test_support.hpp"
 #include "wavetrace/film.hpp"
 
@@ -63,7 +64,7 @@ json without(json doc, const std::string& pointer) {
 std::string error_of_text(const std::string& text, const std::string& source = kSource) {
   try {
     parse_scene(text, source);
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "(no error)";
@@ -242,7 +243,7 @@ TEST(SceneParser, MissingFileIsReported) {
   try {
     load_scene(path);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), path + ": cannot open scene file (No such file or directory)");
   }
 }
@@ -476,7 +477,7 @@ TEST(SceneParser, UnreadableTextureIsReported) {
   try {
     load_scene(scene);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     expect_error(e.what(), "/textures/2/file", "cannot read image '" + dir.path() + "/missing.png' (", scene);
   }
 
@@ -485,7 +486,7 @@ TEST(SceneParser, UnreadableTextureIsReported) {
   try {
     load_scene(corrupt);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     std::string message = e.what();
     expect_error(message, "/textures/2/file", "cannot read image '" + dir.path() + "/corrupt.png' (", corrupt);
     EXPECT_EQ(message.find("()"), std::string::npos) << "stb's reason is missing: " << message;
@@ -500,7 +501,7 @@ TEST(SceneParser, TextureThatIsADirectorySaysSo) {
   try {
     load_scene(scene);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), scene + ": /textures/2/file: cannot read image '" + dir.path() +
                                          "/folder.png' (it is a directory, not a file)");
   }
@@ -515,7 +516,7 @@ TEST(SceneParser, TextureThatIsALoopOfLinksSaysSo) {
   try {
     load_scene(scene);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), scene + ": /textures/2/file: cannot read image '" + a.string() +
                                          "' (cannot open it (a loop of symbolic links))");
   }
@@ -541,7 +542,7 @@ TEST(SceneParser, TruncatedPngTextureSaysItIsCutShort) {
   try {
     load_scene(scene);
     ADD_FAILURE() << "no error";
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     const std::string message = e.what();
     expect_error(message, "/textures/2/file",
                  "cannot read image '" + dir.path() + "/cut.png' (the file is cut short: it ends before its image does (",

@@ -18,6 +18,7 @@
 
 #include "app/job.hpp"
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "render/renderer.hpp"
 #include "render/split.hpp"
 #include "render_support.hpp"
@@ -166,7 +167,7 @@ TEST(Split, AFailingDeviceFailsTheRenderAndSaysWhich) {
     return [d, &o, &failed](const RenderOptions&) -> RenderResult {
       if (d == 1) {
         failed = true;
-        throw SceneError("width x height: too large for this device");
+        throw InputError("width x height: too large for this device");
       }
       while (!failed) std::this_thread::yield();
       RenderResult r;
@@ -174,7 +175,7 @@ TEST(Split, AFailingDeviceFailsTheRenderAndSaysWhich) {
       return r;
     };
   };
-  EXPECT_THROW(render_split(o, {"gpu:0", "gpu:1"}, bad_chunk), SceneError);
+  EXPECT_THROW(render_split(o, {"gpu:0", "gpu:1"}, bad_chunk), InputError);
   // A chunk whose film has the wrong size is the device's failure, not a crash.
   auto short_film = [](size_t) -> ChunkRenderer { return [](const RenderOptions&) { return RenderResult{}; }; };
   EXPECT_THROW(render_split(o, {"gpu:0"}, short_film), DeviceError);
@@ -311,12 +312,12 @@ TEST(Split, DeviceListsAreParsedAndChecked) {
   EXPECT_EQ(parse_devices("1,0", Backend::Cuda, 2), (std::vector<int>{1, 0}));
   EXPECT_EQ(parse_devices("0,1,2", Backend::Cpu, 0), (std::vector<int>{0, 1, 2}));
   for (const char* bad : {"0,", "a", "0;1", "-1", ",0", "0,,1"}) {
-    EXPECT_THROW(parse_devices(bad, Backend::Cpu, 0), SceneError) << bad;
+    EXPECT_THROW(parse_devices(bad, Backend::Cpu, 0), InputError) << bad;
   }
   try {
     parse_devices("0,2", Backend::Cuda, 2);
     FAIL();
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "devices: 2 is not a CUDA device (2 present)");
   }
 }

@@ -19,6 +19,7 @@
 #include "app/process.hpp"
 #include "app/signals.hpp"
 
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
@@ -184,7 +185,7 @@ void read_measurements(const std::string& path, JobOutcome& o) {
   std::string text;
   try {
     text = read_input_file(path, InputKind{"stats file", input::kJobs.max_bytes});
-  } catch (const SceneError&) {
+  } catch (const InputError&) {
     return;
   }
   const json j = json::parse(text, nullptr, false);

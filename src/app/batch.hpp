@@ -30,7 +30,7 @@ int run_batch(const std::vector<PlannedJob>& jobs, bool skip_done = false);
 // The lanes a batch runs its jobs in at once (run_batch_in_processes): one per CUDA
 // device of `devices` ("all" or a list; `present` devices), or with fewer jobs than
 // devices one per job, each over its share of them; a single lane ("": the jobs'
-// own devices) on the CPU backend or with one device. Throws SceneError for a bad list.
+// own devices) on the CPU backend or with one device. Throws InputError for a bad list.
 // Of an MPI run, the ranks on one host share its devices out (distributed.hpp's local_share).
 std::vector<std::string> batch_lanes(const std::string& devices, const std::string& backend, size_t jobs,
                                      int present, const Cluster& cluster = Cluster());

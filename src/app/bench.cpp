@@ -14,6 +14,7 @@
 #include "app/stats.hpp"
 #include "build_info.hpp"
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
@@ -68,13 +69,13 @@ BenchSpec read_bench_spec(const std::string& path, const std::string& only) {
       if (p.params.roulette_depth < 0) p.params.roulette_depth = p.params.depth;
       try {
         validate_params(p.params);
-      } catch (const SceneError& e) {
+      } catch (const InputError& e) {
         r.fail_at(at, e.what());
       }
       if (only.empty() || name == only) spec.points.push_back(p);
     }
   }
-  if (spec.points.empty()) throw SceneError(path + ": no points to run" + (only.empty() ? "" : " in group " + only));
+  if (spec.points.empty()) throw InputError(path + ": no points to run" + (only.empty() ? "" : " in group " + only));
   return spec;
 }
 

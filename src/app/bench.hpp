@@ -36,7 +36,7 @@ struct BenchSpec {
 };
 
 // Reads a spec as scene files are read: unknown and repeated keys are errors, and
-// every error is one line naming the file and the JSON path. Throws SceneError.
+// every error is one line naming the file and the JSON path. Throws InputError.
 BenchSpec read_bench_spec(const std::string& path, const std::string& only);
 
 // Returns the exit code: 0 when every point ran and passed its image check.

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
+#include "errors/errors.hpp"
 #include "image/image_io.hpp"
 #include "render/settings.hpp"
 #include "scene/input_file.hpp"
@@ -43,7 +44,7 @@ json identity_json(const CheckpointIdentity& id) {
 }
 
 [[noreturn]] void damaged(const std::string& path, const std::string& what) {
-  throw SceneError(path + ": not a usable checkpoint: " + what);
+  throw InputError(path + ": not a usable checkpoint: " + what);
 }
 
 // A header's count: a JSON integer (not 2.5, not "2") in lo..hi.
@@ -156,7 +157,7 @@ Checkpoint read_checkpoint(const std::string& path) {
 
 void require_same_render(const std::string& path, const CheckpointIdentity& then, const CheckpointIdentity& now) {
   auto refuse = [&](const std::string& what) {
-    throw SceneError(path + ": the checkpoint is of another render: " + what);
+    throw InputError(path + ": the checkpoint is of another render: " + what);
   };
   if (then.renderer != now.renderer) refuse("made by " + then.renderer + ", this is " + now.renderer);
   if (then.scene_crc != now.scene_crc) {

@@ -25,7 +25,7 @@ struct CheckpointIdentity {
   static constexpr const char* kRendererVersion = "wavetrace 0.3 (light transport of 2026-11)";
 };
 
-// Reads the scene file and fills the identity; throws SceneError if it cannot be read.
+// Reads the scene file and fills the identity; throws InputError if it cannot be read.
 CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
                                        const std::string& kernel, const std::string& backend);
 
@@ -38,11 +38,11 @@ struct Checkpoint {
 // Writes atomically (temporary file renamed into place); throws OutputError.
 void write_checkpoint(const std::string& path, const Checkpoint& checkpoint);
 
-// Reads and checks the checksum and the format; throws SceneError naming the file
+// Reads and checks the checksum and the format; throws InputError naming the file
 // and what is wrong.
 Checkpoint read_checkpoint(const std::string& path);
 
-// Throws SceneError naming the file and the first thing that differs.
+// Throws InputError naming the file and the first thing that differs.
 void require_same_render(const std::string& path, const CheckpointIdentity& checkpoint,
                          const CheckpointIdentity& now);
 

@@ -1,5 +1,6 @@
 #include "app/cli.hpp"
 
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 

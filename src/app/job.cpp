@@ -19,6 +19,7 @@
 #include "app/signals.hpp"
 #include "app/stats.hpp"
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "render/split.hpp"
 
 namespace wt::app {
@@ -31,7 +32,7 @@ Backend parse_backend(const std::string& name) {
     std::fprintf(stderr, "wavetrace: no CUDA device found; rendering on the CPU backend\n");
     return Backend::Cpu;
   }
-  throw SceneError("backend: unknown backend '" + name + "' (expected cuda, cpu or auto)");
+  throw InputError("backend: unknown backend '" + name + "' (expected cuda, cpu or auto)");
 }
 
 std::vector<int> parse_devices(const std::string& text, Backend backend, int present) {
@@ -49,7 +50,7 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
     const std::string item = text.substr(at, comma - at);
     const bool digits = !item.empty() && item.size() <= 4 && item.find_first_not_of("0123456789") == std::string::npos;
     if (!digits) {
-      throw SceneError("devices: '" + text + "' is not 'all' or a list of device indices such as 0,1");
+      throw InputError("devices: '" + text + "' is not 'all' or a list of device indices such as 0,1");
     }
     out.push_back(std::stoi(item));
     at = comma + 1;
@@ -83,8 +84,8 @@ RenderParams resolve_params(const Scene& scene, const Job& job) {
   }
   try {
     validate_params(p);
-  } catch (const SceneError& e) {
-    throw SceneError(job.scene + ": settings: " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(job.scene + ": settings: " + e.what());
   }
   return p;
 }
@@ -138,7 +139,7 @@ template <class F>
 void guarded(JobOutcome& out, F&& phase) {
   try {
     phase();
-  } catch (const SceneError& e) {
+  } catch (const InputError& e) {
     out.exit_code = kExitBadInput;
     out.message = e.what();
   } catch (const OutputWriteError& e) {
@@ -191,7 +192,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
       try {
         const std::vector<int> devices = parse_devices(job.devices, Backend::Cuda, cuda::device_count());
         if (!devices.empty()) first = devices[0];
-      } catch (const SceneError&) {
+      } catch (const InputError&) {
       }
       cuda::start_context(first);
     });
@@ -236,7 +237,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     out.kernel = kernel_name(options.kernel);
     if (distributed) {
       if (!job.checkpoint.empty() || !job.resume.empty()) {
-        throw SceneError(std::string(job.checkpoint.empty() ? "resume" : "checkpoint") +
+        throw InputError(std::string(job.checkpoint.empty() ? "resume" : "checkpoint") +
                          ": checkpoints are kept by one process; a render over " + std::to_string(cluster.ranks()) +
                          " MPI ranks has none (render its parts as jobs of a batch instead)");
       }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "app/cluster.hpp"
+#include "errors/errors.hpp"
 #include "image/image_io.hpp"
 #include "render/renderer.hpp"
 #include "render/settings.hpp"
@@ -91,9 +92,9 @@ const std::string& checkpoint_of(const Job& job);
 // Pixels (RGB triples) with a NaN or an infinity in any channel.
 uint64_t count_nonfinite_pixels(const std::vector<float>& rgb);
 
-Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws SceneError
+Backend parse_backend(const std::string& name);  // "cuda" | "cpu" | "auto"; throws InputError
 // Job::devices as the render's device list for `backend` (`present`: CUDA devices
-// present); throws SceneError naming the field for anything else.
+// present); throws InputError naming the field for anything else.
 std::vector<int> parse_devices(const std::string& text, Backend backend, int present);
 
 }  // namespace wt::app

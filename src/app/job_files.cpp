@@ -11,6 +11,7 @@
 #include <map>
 #include <utility>
 
+#include "errors/errors.hpp"
 #include "image/image_io.hpp"
 #include "scene/input_file.hpp"
 

@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/input_file.hpp"
 #include "scene/json_reader.hpp"
@@ -31,7 +32,7 @@ const std::vector<std::string>& job_keys() {
   return keys;
 }
 
-// Applies the fields of one JSON object to a job; throws SceneError naming the file and field.
+// Applies the fields of one JSON object to a job; throws InputError naming the file and field.
 void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, const fs::path& base, Job& job) {
   r.check_keys(obj, path, job_keys());
   for (auto it = obj.begin(); it != obj.end(); ++it) {
@@ -89,9 +90,9 @@ BatchInput batch_input(const std::string& path) {
   if (doc.is_object() && doc.contains("jobs")) return BatchInput::JobsFile;
   if (doc.is_object() && doc.contains("camera")) return BatchInput::Scene;
   if (doc.is_object() && doc.contains("defaults")) {
-    throw SceneError(path + ": /jobs: required key is missing (a jobs file lists its jobs under \"jobs\")");
+    throw InputError(path + ": /jobs: required key is missing (a jobs file lists its jobs under \"jobs\")");
   }
-  throw SceneError(path + ": neither a jobs file nor a scene file: a jobs file needs \"jobs\" (a list of jobs), a "
+  throw InputError(path + ": neither a jobs file nor a scene file: a jobs file needs \"jobs\" (a list of jobs), a "
                           "scene file \"camera\" and \"materials\"");
 }
 
@@ -102,7 +103,7 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
   std::map<size_t, std::string> job_duplicates;
   for (const std::string& at : duplicates) {
     const std::optional<size_t> job = job_of_pointer(at);
-    if (!job) throw SceneError(path + ": " + at + ": duplicate key");
+    if (!job) throw InputError(path + ": " + at + ": duplicate key");
     job_duplicates.emplace(*job, path + ": " + at + ": duplicate key");
   }
   const JsonReader r(path);
@@ -118,11 +119,11 @@ std::vector<PlannedJob> read_jobs_file(const std::string& path, const Job& base)
     PlannedJob planned{defaults, ""};
     const JsonPath at = jobs_path / i;
     try {
-      if (auto d = job_duplicates.find(i); d != job_duplicates.end()) throw SceneError(d->second);
+      if (auto d = job_duplicates.find(i); d != job_duplicates.end()) throw InputError(d->second);
       apply_fields(r, list[i], at, folder, planned.job);
       if (planned.job.scene.empty()) r.fail_at(at / "scene", "required key is missing (in the job or its defaults)");
       if (planned.job.output.empty()) r.fail_at(at / "output", "required key is missing (in the job or its defaults)");
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       planned.error = e.what();
     }
     jobs.push_back(planned);

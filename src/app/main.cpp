@@ -15,6 +15,7 @@
 #include "app/job.hpp"
 #include "app/job_files.hpp"
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
@@ -162,7 +163,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
     std::vector<std::string> lanes;
     try {
       lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, SIZE_MAX, wt::cuda::device_count(), cluster);
-    } catch (const wt::SceneError&) {
+    } catch (const wt::InputError&) {
       lanes = {""};  // rank 0 reads the same list, and says what is wrong with it
     }
     return wt::app::run_batch_in_processes(jobs, skip_done, "/proc/self/exe", lanes, cluster, processes);
@@ -179,7 +180,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
         jobs.push_back({j, ""});
       }
     }
-  } catch (const wt::SceneError& e) {
+  } catch (const wt::InputError& e) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;
@@ -205,7 +206,7 @@ int run(int argc, char** argv, const wt::app::Cluster& cluster) {
   try {
     const int present = batch_job.backend == "cpu" ? 0 : wt::cuda::device_count();
     lanes = wt::app::batch_lanes(batch_job.devices, batch_job.backend, jobs.size(), present, cluster);
-  } catch (const wt::SceneError& e) {
+  } catch (const wt::InputError& e) {
     std::fprintf(stderr, "wavetrace: %s\n", e.what());
     if (cluster.distributed()) wt::app::release_ranks(cluster);
     return wt::app::kExitBadInput;

@@ -1,4 +1,5 @@
 #include "app/stats.hpp"
+#include "errors/errors.hpp"
 
 #include <filesystem>
 

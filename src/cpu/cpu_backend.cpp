@@ -7,6 +7,7 @@
 
 #include "cpu/cpu_wavefront.hpp"
 #include "cpu/parallel.hpp"
+#include "errors/errors.hpp"
 #include "render/passes.hpp"
 #include "render/settings.hpp"
 #include "render/split.hpp"
@@ -89,7 +90,7 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const RenderParams& rp = options.params;
   if (!kernel_runs_on(options.kernel, Backend::Cpu)) {
-    throw SceneError(std::string("kernel: ") + kernel_name(options.kernel) +
+    throw InputError(std::string("kernel: ") + kernel_name(options.kernel) +
                      " needs the cuda backend (constant memory is a GPU memory)");
   }
   if (options.devices.size() > 1) {

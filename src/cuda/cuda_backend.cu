@@ -10,6 +10,7 @@
 #include "cuda/buffer.hpp"
 #include "cuda/device_scene.hpp"
 #include "cuda/event.hpp"
+#include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "cuda/cuda_wavefront.hpp"
 #include "render/passes.hpp"
@@ -101,7 +102,7 @@ size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_si
 void require_device_memory(const RenderParams& rp, size_t need, size_t free_bytes, const std::string& device) {
   const size_t usable = free_bytes - std::min(free_bytes, size_t(256) << 20);  // headroom for the runtime
   if (need > usable) {
-    throw SceneError("width x height: " + std::to_string(rp.width) + " x " + std::to_string(rp.height) +
+    throw InputError("width x height: " + std::to_string(rp.width) + " x " + std::to_string(rp.height) +
                      " with this kernel needs " + mib(need) + " of device memory; " + device + " has " +
                      mib(free_bytes) + " free");
   }

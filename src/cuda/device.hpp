@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <string>
 
-#include "render/errors.hpp"
+#include "errors/errors.hpp"
 
 namespace wt::cuda {
 

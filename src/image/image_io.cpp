@@ -1,4 +1,5 @@
 #include "image/image_io.hpp"
+#include "errors/errors.hpp"
 
 #include <IexBaseExc.h>
 #include <ImfChannelList.h>

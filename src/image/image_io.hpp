@@ -8,18 +8,8 @@
 #include <string>
 #include <vector>
 
+
 namespace wt {
-
-struct OutputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// The output path passed its checks but the write failed: the disk filled up (ENOSPC),
-// the file grew past a limit (EFBIG), the disk failed (EIO). A failure of the machine,
-// not of the input; the message names the file and the system's reason.
-struct OutputWriteError : OutputError {
-  using OutputError::OutputError;
-};
 
 enum class Encoding { Srgb, Gamma2 };
 // The pixel type of an OpenEXR image's channels.

@@ -18,7 +18,7 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();
 
-// Copies the scene into __constant__ memory; throws SceneError if it does not fit.
+// Copies the scene into __constant__ memory; throws InputError if it does not fit.
 // `images` are the device image views (texture objects) of the uploaded scene.
 void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images);
 

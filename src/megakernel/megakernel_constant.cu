@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "megakernel/megakernel_body.cuh"
 
@@ -104,7 +105,7 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   cs.layout.lights = place(scene.lights);
   cs.layout.light_cdf = place(scene.light_cdf);
   if (pool.size() > kPoolBytes) {
-    throw SceneError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
+    throw InputError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
                      " bytes of constant memory; megakernel-constant holds at most " + std::to_string(kPoolBytes) +
                      " (use --kernel megakernel)");
   }

@@ -10,7 +10,6 @@
 #include <string>
 #include <vector>
 
-#include "render/errors.hpp"
 #include "wavetrace/scene_view.hpp"
 
 namespace wt {

@@ -1,4 +1,5 @@
 #include "render/renderer.hpp"
+#include "errors/errors.hpp"
 
 #include <string>
 
@@ -29,13 +30,13 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
   if (options.wave_size != 0) check_setting(SettingId::WaveSize, options.wave_size);
   if (options.first_sample < 0 || options.first_sample >= p.spp || options.sample_count < 0 ||
       options.sample_count > p.spp - options.first_sample) {
-    throw SceneError("samples: " + std::to_string(options.first_sample) + " + " +
+    throw InputError("samples: " + std::to_string(options.first_sample) + " + " +
                      std::to_string(options.sample_count) + " does not lie within the " + std::to_string(p.spp) +
                      " samples per pixel");
   }
   const size_t film_floats = static_cast<size_t>(p.width) * p.height * 3;
   if (options.initial_film && options.initial_film->size() != film_floats) {
-    throw SceneError("film: the sums to start from hold " + std::to_string(options.initial_film->size()) +
+    throw InputError("film: the sums to start from hold " + std::to_string(options.initial_film->size()) +
                      " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
                      std::to_string(film_floats));
   }

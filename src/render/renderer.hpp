@@ -10,7 +10,7 @@ namespace wt {
 
 const char* backend_name(Backend b);
 
-// Fails with SceneError for settings the backend cannot honour (naming the setting),
+// Fails with InputError for settings the backend cannot honour (naming the setting),
 // and DeviceError (cuda::CudaError for CUDA calls, naming the call and the stage)
 // when the machine fails. The result holds each pixel's mean radiance.
 RenderResult render(const Scene& scene, const RenderOptions& options);
@@ -23,7 +23,7 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options);
 // last step; also for a film that was complete when it was resumed).
 void take_mean(RenderResult& r);
 
-// Checks RenderParams against the sane limits; throws SceneError naming the setting.
+// Checks RenderParams against the sane limits; throws InputError naming the setting.
 void validate_params(const RenderParams& p);
 
 // Params from the scene's defaults.

@@ -1,7 +1,7 @@
 #include "render/settings.hpp"
 
+#include "errors/errors.hpp"
 #include "queues/wave.hpp"
-#include "scene/json_reader.hpp"
 
 namespace wt {
 
@@ -66,7 +66,7 @@ void set_param(RenderParams& p, SettingId id, int64_t value) {
 void check_setting(SettingId id, int64_t value) {
   const Setting& s = setting(id);
   if (value < s.lo || value > s.hi) {
-    throw SceneError(std::string(s.key) + ": must be in " + std::to_string(s.lo) + ".." + std::to_string(s.hi) +
+    throw InputError(std::string(s.key) + ": must be in " + std::to_string(s.lo) + ".." + std::to_string(s.hi) +
                      " (got " + std::to_string(value) + ")");
   }
 }
@@ -134,7 +134,7 @@ Kernel parse_kernel(const std::string& name) {
   for (Kernel k : kernels()) {
     if (name == kernel_name(k)) return k;
   }
-  throw SceneError("kernel: unknown kernel '" + name + "' (expected " + listed(kernel_names()) + ")");
+  throw InputError("kernel: unknown kernel '" + name + "' (expected " + listed(kernel_names()) + ")");
 }
 
 const std::vector<std::string>& backend_choices() {

@@ -8,9 +8,26 @@
 #include <string>
 #include <vector>
 
+#include "errors/errors.hpp"
 #include "render/render_types.hpp"
 
 namespace wt {
+
+// The sane limits of a render's settings, wherever they are given (scene file,
+// command line, jobs file, bench spec), gathered with the defaults below into the one
+// table of settings that every reader checks against.
+constexpr int kMaxImageSide = 16384;
+constexpr int kMaxSpp = 1000000;
+constexpr int kMaxPathDepth = 1024;
+// Russian roulette starts at the latest after this many bounces (a path never gets
+// near it: depth is at most kMaxPathDepth).
+constexpr int kMaxRouletteDepth = 1 << 30;
+
+// A render's settings where nothing gives them: a scene's, unless its `render`
+// section says otherwise.
+struct RenderDefaults : RenderParams {
+  RenderDefaults() : RenderParams{640, 360, 16, 10, 5, 1} {}
+};
 
 enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Nee, Warmup, WaveSize, Threads, CheckpointEvery };
 
@@ -36,7 +53,7 @@ const std::vector<SettingId>& render_settings();
 int64_t get_param(const RenderParams& p, SettingId id);
 void set_param(RenderParams& p, SettingId id, int64_t value);
 
-// Throws SceneError "<key>: must be in lo..hi (got value)" when value is out of range.
+// Throws InputError "<key>: must be in lo..hi (got value)" when value is out of range.
 void check_setting(SettingId id, int64_t value);
 
 // The kernels, in the order the docs and plots list them, their names, and the
@@ -46,7 +63,7 @@ const char* kernel_name(Kernel k);
 bool kernel_runs_on(Kernel kernel, Backend backend);
 std::vector<std::string> kernel_names();
 std::vector<std::string> kernel_names(Backend backend);
-Kernel parse_kernel(const std::string& name);  // throws SceneError naming the kernels
+Kernel parse_kernel(const std::string& name);  // throws InputError naming the kernels
 
 // The names a backend may be asked for ("auto": CUDA when a device is present), and
 // the PNG encodings.

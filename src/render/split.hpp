@@ -26,6 +26,7 @@
 
 #include "cpu/parallel.hpp"
 #include "cuda/device.hpp"
+#include "errors/errors.hpp"
 #include "render/passes.hpp"
 #include "render/render_types.hpp"
 #include "scene/scene.hpp"
@@ -38,13 +39,13 @@ constexpr int kChunksPerDevice = 4;
 // devices the chunks are its passes (progress then moves as often as on one device).
 constexpr int kMinChunks = 10;
 
-// Throws SceneError naming the first index that is not one of the `present` CUDA
+// Throws InputError naming the first index that is not one of the `present` CUDA
 // devices (0..present-1): the one check of a device list, from the command line or
 // from a caller's options.
 inline void require_cuda_devices(const std::vector<int>& devices, int present) {
   for (int d : devices) {
     if (d < 0 || d >= present) {
-      throw SceneError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
+      throw InputError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
                        " present)");
     }
   }
@@ -112,8 +113,8 @@ inline void add_into(std::vector<float>& sums, std::vector<float>&& more) {
 [[noreturn]] inline void rethrow_naming(const std::exception_ptr& e, const std::string& device) {
   try {
     std::rethrow_exception(e);
-  } catch (const SceneError& x) {
-    throw SceneError(device + ": " + x.what());
+  } catch (const InputError& x) {
+    throw InputError(device + ": " + x.what());
   } catch (const cuda::CudaError& x) {
     throw cuda::CudaError(device + ": " + x.what());
   } catch (const DeviceError& x) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <string>
 
+#include "errors/errors.hpp"
 #include "scene/scene.hpp"
 
 namespace wt {
@@ -17,8 +18,8 @@ namespace wt {
 // What read_input_file throws: the whole line, and its reason alone ("it is a
 // directory, not a file", "cannot open it (No such file or directory)") for a caller
 // that names the file in words of its own.
-struct InputFileError : SceneError {
-  InputFileError(const std::string& line, std::string why) : SceneError(line), reason(std::move(why)) {}
+struct InputFileError : InputError {
+  InputFileError(const std::string& line, std::string why) : InputError(line), reason(std::move(why)) {}
   std::string reason;
 };
 

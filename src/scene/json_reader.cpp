@@ -1,3 +1,4 @@
+#include "errors/errors.hpp"
 #include "scene/json_reader.hpp"
 
 #include <algorithm>
@@ -54,7 +55,7 @@ class DomBuilder : public nlohmann::json_sax<json> {
       std::string path = path_of_open_containers();
       path += '/';
       append_token(path, k);  // not moved from: try_emplace inserted nothing
-      if (!duplicates_) throw SceneError(source_ + ": " + path + ": duplicate key");
+      if (!duplicates_) throw InputError(source_ + ": " + path + ": duplicate key");
       // Recorded, and the repeated value read into a place of its own and dropped.
       duplicates_->push_back(std::move(path));
       member_ = &dropped_.emplace_back();
@@ -82,7 +83,7 @@ class DomBuilder : public nlohmann::json_sax<json> {
     std::string what = e.what();
     size_t tag_end = what.find("] ");
     if (what.rfind("[json.exception.", 0) == 0 && tag_end != std::string::npos) what = what.substr(tag_end + 2);
-    throw SceneError(source_ + ": malformed JSON: " + what);
+    throw InputError(source_ + ": malformed JSON: " + what);
   }
 
  private:
@@ -163,14 +164,8 @@ json read_json_file(const std::string& path, const InputKind& kind) {
   return parse_json(read_input_file(path, kind), path);
 }
 
-std::string listed(const std::vector<std::string>& names) {
-  std::string out;
-  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
 void JsonReader::fail_at(const JsonPath& path, const std::string& what) const {
-  throw SceneError(source_ + ": " + path.str() + ": " + what);
+  throw InputError(source_ + ": " + path.str() + ": " + what);
 }
 
 void JsonReader::object(const json& j, const JsonPath& path) const {

@@ -38,7 +38,7 @@ class JsonPath {
 
 // Parses JSON text, rejecting a key repeated in one object (nlohmann would keep the
 // last value without a word). Time and memory are linear in the text. Throws
-// SceneError "<source>: malformed JSON: ..." or "<source>: /path: duplicate key".
+// InputError "<source>: malformed JSON: ..." or "<source>: /path: duplicate key".
 // With `duplicates`, a repeated key is not thrown but its JSON pointer recorded there,
 // the first value kept (a jobs file fails the one job that holds it).
 json parse_json(const std::string& text, const std::string& source, std::vector<std::string>* duplicates = nullptr);
@@ -47,7 +47,7 @@ json parse_json(const std::string& text, const std::string& source, std::vector<
 // and parses it as above.
 json read_json_file(const std::string& path, const InputKind& kind);
 
-// The typed field readers: each checks one value and throws SceneError
+// The typed field readers: each checks one value and throws InputError
 // "<source>: <path>: <what is wrong>".
 class JsonReader {
  public:
@@ -82,7 +82,5 @@ class JsonReader {
   std::string source_;
 };
 
-// "a, b, c"
-std::string listed(const std::vector<std::string>& names);
 
 }  // namespace wt

@@ -22,6 +22,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "errors/errors.hpp"
 #include "scene/input_file.hpp"
 #include "scene/json_reader.hpp"
 #include "scene/mesh_libraries.hpp"
@@ -33,7 +34,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) { throw SceneError(path + ": " + what); }
+[[noreturn]] void fail(const std::string& path, const std::string& what) { throw InputError(path + ": " + what); }
 
 bool finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -210,7 +211,7 @@ class MaterialLibraries : public tinyobj::MaterialReader {
     std::string text;
     try {
       text = read_input_file(file, input::kMaterialLibrary);
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       if (error_.empty()) error_ = std::string("mtllib ") + name + ": " + e.what();
       if (err) *err += error_ + "\n";
       return false;
@@ -743,7 +744,7 @@ struct GltfFiles {
       const std::string bytes = read_input_file(path, input::kGltfBuffer);
       out->assign(bytes.begin(), bytes.end());
       return true;
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       if (files.error.empty()) files.error = e.what();
       if (err) *err += std::string(e.what()) + "\n";
       return false;

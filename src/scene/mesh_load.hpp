@@ -35,7 +35,7 @@ struct TriangleMesh {
 
 // Reads a mesh file, its format chosen by extension (.obj, .gltf, .glb; any case).
 // A glTF file's default scene (or its first; or, with none, every mesh) is read with
-// its node transforms applied. Throws SceneError "<path>: <what is wrong>".
+// its node transforms applied. Throws InputError "<path>: <what is wrong>".
 TriangleMesh load_mesh(const std::string& path);
 
 }  // namespace wt

@@ -5,29 +5,19 @@
 #include <string>
 #include <vector>
 
+#include "render/settings.hpp"
 #include "scene/bvh_build.hpp"
 #include "scene/environment_distribution.hpp"
 #include "wavetrace/scene_view.hpp"
 
 namespace wt {
 
-// A scene or settings error that names the file and the JSON path of the field.
-struct SceneError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 struct Image {
   std::string path;  // as resolved from the scene file
   int width = 0, height = 0;
   std::vector<float> texels;  // RGBA, linear, row 0 = top
 };
-
-// The sane limits of a render's settings, wherever they are given (scene file,
-// command line, jobs file, bench spec). src/render/settings.cpp gathers them, with
-// the defaults below, into the one table of settings that every reader checks against.
-constexpr int kMaxImageSide = 16384;
-constexpr int kMaxSpp = 1000000;
-constexpr int kMaxPathDepth = 1024;
 
 // The bounds of a scene's numbers, refused at load beyond them, so that no product the
 // renderer forms of them leaves float's range (3.4e38): a radiance (an emission, a
@@ -37,15 +27,6 @@ constexpr int kMaxPathDepth = 1024;
 // distances and cross products (1e30) do.
 constexpr float kMaxRadiance = 1e9f;
 constexpr float kMaxCoordinate = 1e15f;
-
-// Russian roulette starts at the latest after this many bounces (a path never gets
-// near it: depth is at most kMaxPathDepth).
-constexpr int kMaxRouletteDepth = 1 << 30;
-
-// A scene's render settings: the defaults below unless its `render` section says otherwise.
-struct RenderDefaults : RenderParams {
-  RenderDefaults() : RenderParams{640, 360, 16, 10, 5, 1} {}
-};
 
 // How long each host-side phase of loading a scene took, in seconds (wall clock).
 // Uploading to the device is timed by the backend (RenderResult::upload_seconds).
@@ -147,7 +128,7 @@ struct Scene::Summary {
 };
 
 // Reads, validates and prepares (BVH built, sort keys set) a scene file.
-// Throws SceneError naming the file and the field.
+// Throws InputError naming the file and the field.
 Scene load_scene(const std::string& path);
 
 // The same from JSON text; `source` names the file in messages and anchors

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "scene/scene.hpp"
+#include "errors/errors.hpp"
 #include "wavetrace/scene_lights.hpp"
 
 namespace wt {
@@ -95,7 +96,7 @@ void build_bvh(Scene& scene) {
     try {
       tree = build_bvh(prims, blas_options);
     } catch (const std::length_error& e) {
-      throw SceneError(scene.source + ": /spheres: " + e.what());
+      throw InputError(scene.source + ": /spheres: " + e.what());
     }
     permute_range(scene.spheres, 0, tree.order);
     permute_range(scene.sphere_material, 0, tree.order);
@@ -113,7 +114,7 @@ void build_bvh(Scene& scene) {
     try {
       tree = build_bvh(prims, blas_options);
     } catch (const std::length_error& e) {
-      throw SceneError(mesh.file + ": " + e.what());
+      throw InputError(mesh.file + ": " + e.what());
     }
     permute_range(scene.triangles, mesh.first_triangle, tree.order);
     permute_range(scene.triangle_shading, mesh.first_triangle, tree.order);
@@ -136,7 +137,7 @@ void build_bvh(Scene& scene) {
         const size_t instance = i - (scene.spheres.empty() ? 0 : 1);  // the spheres' placement comes first
         char value[32];
         std::snprintf(value, sizeof value, "%g", static_cast<double>(reach));
-        throw SceneError(scene.source + ": /instances/" + std::to_string(instance) + ": the placed mesh '" +
+        throw InputError(scene.source + ": /instances/" + std::to_string(instance) + ": the placed mesh '" +
                          scene.meshes[p.mesh].name + "' reaches a coordinate of " + value +
                          ", beyond +-1e15, the largest a scene may hold");
       }
@@ -146,7 +147,7 @@ void build_bvh(Scene& scene) {
   try {
     top = build_bvh(boxes, tlas_options);
   } catch (const std::length_error& e) {
-    throw SceneError(scene.source + ": /instances: " + e.what());
+    throw InputError(scene.source + ": /instances: " + e.what());
   }
   scene.top_level_bvh = bvh_stats(top.nodes, tlas_options);
   scene.nodes = std::move(top.nodes);
@@ -156,7 +157,7 @@ void build_bvh(Scene& scene) {
     mesh_roots[m] = append_tree(scene.nodes, mesh_trees[m], scene.meshes[m].first_triangle);
   }
   if (scene.nodes.size() > static_cast<size_t>(INT32_MAX)) {
-    throw SceneError(scene.source + ": too many BVH nodes for 32-bit indices");
+    throw InputError(scene.source + ": too many BVH nodes for 32-bit indices");
   }
   scene.instances.resize(top.order.size());
   for (size_t i = 0; i < top.order.size(); ++i) {

@@ -6,6 +6,7 @@
 #include <thread>
 #include <utility>
 
+#include "errors/errors.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace wt {

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "scene/mesh_load.hpp"
+#include "errors/errors.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace wt {
@@ -53,17 +54,17 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   for (size_t i = 0; i < loading.size(); ++i) {
     try {
       meshes.push_back(loading[i].get());
-    } catch (const SceneError& e) {
+    } catch (const InputError& e) {
       if (first_error.empty()) first_error = source() + ": " + (path / i / "file").str() + ": " + e.what();
     }
   }
-  if (!first_error.empty()) throw SceneError(first_error);
+  if (!first_error.empty()) throw InputError(first_error);
   mesh_seconds_ += seconds_since(start);
   for (size_t i = 0; i < meshes.size(); ++i) {
     try {
       add_mesh(meshes[i], specs[i].name, specs[i].material);
-    } catch (const SceneError& e) {  // a texture its materials name, its size
-      throw SceneError(source() + ": " + (path / i / "file").str() + ": " + e.what());
+    } catch (const InputError& e) {  // a texture its materials name, its size
+      throw InputError(source() + ": " + (path / i / "file").str() + ": " + e.what());
     }
   }
 }
@@ -72,7 +73,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   const size_t total = scene_.triangles.size() + mesh.triangles.size();
   if (total > static_cast<size_t>(std::numeric_limits<int32_t>::max()) ||
       scene_.normals.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max()) {
-    throw SceneError(mesh.source + ": the scene's meshes hold more than 2^31 - 1 triangles");
+    throw InputError(mesh.source + ": the scene's meshes hold more than 2^31 - 1 triangles");
   }
   // The file's materials join the scene's, named "<mesh>/<material>", unless overridden.
   std::vector<uint32_t> material_of(mesh.materials.size());

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "scene/input_file.hpp"
+#include "errors/errors.hpp"
 #include "scene/scene_reader.hpp"
 #include "wavetrace/film.hpp"
 
@@ -66,7 +67,7 @@ int32_t SceneReader::image(const std::string& file, bool srgb, const JsonPath& p
 int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const std::string& referrer) {
   std::string why;
   int32_t index = image_at(resolved, srgb, why);
-  if (index < 0) throw SceneError(referrer + ": cannot read texture image '" + resolved + "' (" + why + ")");
+  if (index < 0) throw InputError(referrer + ": cannot read texture image '" + resolved + "' (" + why + ")");
   return index;
 }
 
