@@ -20,7 +20,7 @@
 #include "app/batch.hpp"
 #include "app/job.hpp"
 #include "cuda/buffer.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "fault_injection.hpp"
 #include "test_support.hpp"
 

@@ -11,7 +11,7 @@
 
 #include <cstring>
 
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "test_support.hpp"
 
 namespace wt {

@@ -10,7 +10,7 @@
 #include <sstream>
 
 #include "mesh_support.hpp"
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "render_support.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"

@@ -8,7 +8,7 @@
 #include <numeric>
 
 #include "mesh_support.hpp"
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 

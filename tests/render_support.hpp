@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "scene/scene.hpp"
 
 namespace wt::test {

@@ -9,7 +9,7 @@
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "stages/wavefront.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"

@@ -20,7 +20,7 @@
 
 #include "app/batch.hpp"
 #include "cuda/buffer.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {

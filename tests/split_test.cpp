@@ -17,10 +17,10 @@
 #include <vector>
 
 #include "app/job.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "errors/errors.hpp"
-#include "render/renderer.hpp"
-#include "render/split.hpp"
+#include "dispatch/renderer.hpp"
+#include "dispatch/split.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 

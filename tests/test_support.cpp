@@ -11,7 +11,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 
 namespace wt::test {
 

@@ -13,7 +13,7 @@
 #include "app/job.hpp"
 #include "app/stats.hpp"
 #include "build_info.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"

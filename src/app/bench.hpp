@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 
 namespace wt::app {
 

@@ -18,9 +18,8 @@
 #include "app/progress.hpp"
 #include "app/signals.hpp"
 #include "app/stats.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "errors/errors.hpp"
-#include "render/split.hpp"
 
 namespace wt::app {
 
@@ -55,7 +54,7 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
     out.push_back(std::stoi(item));
     at = comma + 1;
   }
-  if (backend == Backend::Cuda) require_cuda_devices(out, present);
+  if (backend == Backend::Cuda) cuda::require_cuda_devices(out, present);
   return out;
 }
 

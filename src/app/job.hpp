@@ -9,7 +9,7 @@
 #include "app/cluster.hpp"
 #include "errors/errors.hpp"
 #include "image/image_io.hpp"
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 #include "render/settings.hpp"
 
 namespace wt::app {

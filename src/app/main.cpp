@@ -14,7 +14,7 @@
 #include "app/cli.hpp"
 #include "app/job.hpp"
 #include "app/job_files.hpp"
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 
-#include "render/renderer.hpp"
+#include "dispatch/renderer.hpp"
 
 namespace wt::app {
 

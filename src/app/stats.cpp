@@ -1,7 +1,8 @@
 #include "app/stats.hpp"
-#include "errors/errors.hpp"
 
 #include <filesystem>
+
+#include "errors/errors.hpp"
 
 namespace wt::app {
 

@@ -10,7 +10,6 @@
 #include "errors/errors.hpp"
 #include "render/passes.hpp"
 #include "render/settings.hpp"
-#include "render/split.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt::cpu {
@@ -87,27 +86,19 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
 
 }  // namespace
 
+DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t) {
+  const int each = std::max(1, thread_count(options.threads) / static_cast<int>(options.devices.size()));
+  return {[&scene, each](const RenderOptions& chunk) {
+            RenderOptions one = chunk;
+            one.devices.clear();
+            one.threads = each;
+            return render(scene, one);
+          },
+          {}, {}};
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& options) {
   const RenderParams& rp = options.params;
-  if (!kernel_runs_on(options.kernel, Backend::Cpu)) {
-    throw InputError(std::string("kernel: ") + kernel_name(options.kernel) +
-                     " needs the cuda backend (constant memory is a GPU memory)");
-  }
-  if (options.devices.size() > 1) {
-    // Host "devices" (the split's logic without GPUs): each a share of the threads.
-    const int each = std::max(1, thread_count(options.threads) / static_cast<int>(options.devices.size()));
-    std::vector<std::string> labels;
-    for (int d : options.devices) labels.push_back("cpu:" + std::to_string(d));
-    return render_split(options, labels, [&](size_t) -> DeviceRenderer {
-      return {[&scene, each](const RenderOptions& chunk) {
-                RenderOptions one = chunk;
-                one.devices.clear();
-                one.threads = each;
-                return render(scene, one);
-              },
-              {}, {}};
-    });
-  }
   std::vector<ImageView> images;
   const SceneView view = host_view(scene, rp.width, rp.height, images);
 

@@ -1,12 +1,21 @@
 // The CPU backend: the megakernel and the wavefront on host threads.
 #pragma once
 
+#include <cstddef>
+
+#include "render/device_renderer.hpp"
 #include "render/render_types.hpp"
 #include "scene/scene.hpp"
 
 namespace wt::cpu {
 
-// Renders on host threads; the result holds pixel sums (render/renderer.hpp divides).
+// Renders on host threads (options.threads, or every core); the result holds pixel
+// sums (dispatch/renderer.hpp divides). One "device": the dispatcher splits a render
+// over several (options.devices) with device_renderer.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+
+// Host "device" i of the render's several (the split's logic without GPUs): a share
+// of the threads, rendering each chunk as render does.
+DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t i);
 
 }  // namespace wt::cpu

@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 
 namespace wt::cuda {
 

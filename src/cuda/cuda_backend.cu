@@ -14,7 +14,6 @@
 #include "megakernel/megakernel.hpp"
 #include "cuda/cuda_wavefront.hpp"
 #include "render/passes.hpp"
-#include "render/split.hpp"
 
 namespace wt::cuda {
 
@@ -179,23 +178,23 @@ class Uploaded {
 
 }  // namespace
 
-RenderResult render(const Scene& scene, const RenderOptions& options) {
+void check_devices(const RenderOptions& options) {
   const int present = device_count();
   if (present == 0) throw DeviceError("backend: cuda was asked for, but no CUDA device is present");
   require_cuda_devices(options.devices, present);
-  if (options.devices.size() > 1) {
-    std::vector<std::string> labels;
-    for (int d : options.devices) labels.push_back("cuda:" + std::to_string(d));
-    return render_split(options, labels, [&](size_t i) -> DeviceRenderer {
-      // The current device is the calling thread's: the worker's from here on.
-      WT_CUDA(cudaSetDevice(options.devices[i]), "device selection");
-      auto uploaded = std::make_shared<Uploaded>(scene, options);
-      return {[uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); },
-              [uploaded](const RenderOptions& chunk) { return uploaded->render_kept(chunk); },
-              [uploaded] { return uploaded->collect(); },
-              [uploaded](const RenderOptions& chunk) { uploaded->prepare_kept(chunk); }};
-    });
-  }
+}
+
+DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t i) {
+  // The current device is the calling thread's: the split's thread for it from here on.
+  WT_CUDA(cudaSetDevice(options.devices[i]), "device selection");
+  auto uploaded = std::make_shared<Uploaded>(scene, options);
+  return {[uploaded](const RenderOptions& chunk) { return uploaded->render(chunk); },
+          [uploaded](const RenderOptions& chunk) { return uploaded->render_kept(chunk); },
+          [uploaded] { return uploaded->collect(); },
+          [uploaded](const RenderOptions& chunk) { uploaded->prepare_kept(chunk); }};
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
   const Uploaded uploaded(scene, options);
   RenderResult out = uploaded.render(options);

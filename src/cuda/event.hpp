@@ -5,7 +5,7 @@
 
 #include <chrono>
 
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 
 namespace wt::cuda {
 

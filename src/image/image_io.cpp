@@ -1,5 +1,4 @@
 #include "image/image_io.hpp"
-#include "errors/errors.hpp"
 
 #include <IexBaseExc.h>
 #include <ImfChannelList.h>
@@ -46,6 +45,7 @@ unsigned char* deflate_for_png(unsigned char* data, int size, int* out_size, int
 #include <utility>
 
 #include "cpu/parallel.hpp"
+#include "errors/errors.hpp"
 #include "wavetrace/film.hpp"
 
 namespace wt {

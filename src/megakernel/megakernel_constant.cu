@@ -4,7 +4,7 @@
 #include <cstring>
 #include <string>
 
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "megakernel/megakernel_body.cuh"

@@ -1,4 +1,4 @@
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 #include "megakernel/megakernel.hpp"
 #include "megakernel/megakernel_body.cuh"
 

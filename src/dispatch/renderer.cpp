@@ -1,15 +1,37 @@
-#include "render/renderer.hpp"
-#include "errors/errors.hpp"
+#include "dispatch/renderer.hpp"
 
 #include <string>
 
 #include "cpu/cpu_backend.hpp"
 #include "cuda/cuda_backend.hpp"
+#include "dispatch/split.hpp"
+#include "errors/errors.hpp"
 #include "render/settings.hpp"
 
 namespace wt {
 
 const char* backend_name(Backend b) { return b == Backend::Cuda ? "cuda" : "cpu"; }
+
+namespace {
+
+// On one device, the backend's own render; on several (options.devices), the split
+// over the backend's renderer of each, labelled "cuda:1", "cpu:0", ...
+RenderResult render_on_backend(const Scene& scene, const RenderOptions& options) {
+  if (!kernel_runs_on(options.kernel, options.backend)) {
+    throw InputError(std::string("kernel: ") + kernel_name(options.kernel) +
+                     " needs the cuda backend (constant memory is a GPU memory)");
+  }
+  const bool gpu = options.backend == Backend::Cuda;
+  if (gpu) cuda::check_devices(options);
+  if (options.devices.size() <= 1) return gpu ? cuda::render(scene, options) : cpu::render(scene, options);
+  std::vector<std::string> labels;
+  for (int d : options.devices) labels.push_back(std::string(backend_name(options.backend)) + ":" + std::to_string(d));
+  return render_split(options, labels, [&](size_t i) {
+    return gpu ? cuda::device_renderer(scene, options, i) : cpu::device_renderer(scene, options, i);
+  });
+}
+
+}  // namespace
 
 
 void validate_params(const RenderParams& p) {
@@ -40,7 +62,7 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
                      " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
                      std::to_string(film_floats));
   }
-  return options.backend == Backend::Cuda ? cuda::render(scene, options) : cpu::render(scene, options);
+  return render_on_backend(scene, options);
 }
 
 void take_mean(RenderResult& r) {

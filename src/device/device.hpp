@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "errors/errors.hpp"
 
@@ -16,6 +17,11 @@ struct CudaError : DeviceError {
 
 // Number of usable CUDA devices; 0 where there is no driver or no device.
 int device_count();
+
+// Throws InputError naming the first index that is not one of the `present` CUDA
+// devices (0..present-1): the one check of a device list, from the command line or
+// from a caller's options.
+void require_cuda_devices(const std::vector<int>& devices, int present);
 
 // Starts the CUDA runtime and the current device's context, which takes a good
 // part of a second, so that it can run while a scene loads. Quiet where there is no

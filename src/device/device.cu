@@ -1,4 +1,4 @@
-#include "cuda/device.hpp"
+#include "device/device.hpp"
 
 #include <cuda_runtime.h>
 
@@ -11,6 +11,15 @@ int device_count() {
     return 0;
   }
   return n;
+}
+
+void require_cuda_devices(const std::vector<int>& devices, int present) {
+  for (int d : devices) {
+    if (d < 0 || d >= present) {
+      throw InputError("devices: " + std::to_string(d) + " is not a CUDA device (" + std::to_string(present) +
+                       " present)");
+    }
+  }
 }
 
 namespace {

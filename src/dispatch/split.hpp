@@ -1,0 +1,42 @@
+// One render over several devices (the GPUs of a host, or host "devices" of the CPU
+// backend): its samples are cut into chunks (the passes the render would make on one
+// device), handed to the devices as they free up, so that a faster or less busy
+// device takes more of them. Each device keeps its chunks' sums and the devices'
+// sums are added in device order; where after_pass must see the film after every
+// chunk, the chunks are folded into the film in their order instead. The wavefront
+// kernels, where no after_pass watches, share the render's paths instead: each
+// device renders all the samples but traces only the blocks of paths it takes from
+// one PathFeed, so that its wave refills across blocks and drains once, at the end,
+// rather than once a chunk. The counter-based random numbers make a path's value
+// independent of where it runs, so the image is the one-device image up to the
+// order of float additions.
+//
+// The dispatcher (dispatch/renderer.cpp) calls it with the backend's renderer of
+// each device (render/device_renderer.hpp); no backend calls it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "render/device_renderer.hpp"
+#include "render/render_types.hpp"
+
+namespace wt {
+
+// Chunks a device gets at least, on average: enough for a faster device to take more.
+constexpr int kChunksPerDevice = 4;
+// At least as many chunks as the CUDA megakernel makes passes on one device: for two
+// devices the chunks are its passes (progress then moves as often as on one device).
+constexpr int kMinChunks = 10;
+
+// Renders `options` over the devices `labels` names (one worker thread each). The
+// result's shares say what each device did; its seconds run from when every device
+// has its scene, its warm-up renders and the memory its sums need, to the film that
+// adds every device's sums (as one device's seconds end with its sums in its memory,
+// before the film comes back; freeing each device's memory comes after). A device
+// that fails stops the others after their current chunk, and the render throws its
+// error, named after the device; no partial result is returned.
+RenderResult render_split(const RenderOptions& options, const std::vector<std::string>& labels,
+                          const MakeChunkRenderer& make);
+
+}  // namespace wt
