@@ -1,4 +1,4 @@
-// A render split over several devices (render/split.hpp): on host "devices" of the
+// A render split over several devices (dispatch/split.hpp): on host "devices" of the
 // CPU backend, and on one GPU named twice (the split's logic on a machine with one
 // device). The N-way image is the one-way image within float-summation rounding (a
 // pixel's samples summed in other groups); bit for bit with the CUDA megakernel on

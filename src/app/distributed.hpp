@@ -1,7 +1,7 @@
 // One render over the ranks of an MPI run (`mpirun -n N wavetrace render ...`): each
 // rank renders a contiguous range of the samples on its host's devices, and rank 0
 // sums the films in rank order and alone writes the image. Like the split over a
-// host's devices (render/split.hpp), the counter-based random numbers make the image
+// host's devices (dispatch/split.hpp), the counter-based random numbers make the image
 // the one-process image within float-summation rounding.
 #pragma once
 

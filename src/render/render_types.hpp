@@ -1,4 +1,4 @@
-// What the dispatcher (render/renderer.hpp) and the backends (cpu/, cuda/) exchange:
+// What the dispatcher (dispatch/renderer.hpp) and the backends (cpu/, cuda/) exchange:
 // the options of one render and its result. A leaf header, so that the backends
 // stand on it without depending on the dispatcher that calls them.
 #pragma once
@@ -34,7 +34,7 @@ using FilmReader = std::function<std::vector<float>()>;
 // sums (from sample 0); returning false stops the render there.
 using PassFn = std::function<bool(int32_t samples_done, const FilmReader& film)>;
 
-// The paths of one render that several devices' wavefronts share (render/split.hpp):
+// The paths of one render that several devices' wavefronts share (dispatch/split.hpp):
 // each pass's paths [0, total) handed out in blocks, each path once, as the devices
 // ask; a device renders the blocks it took and nothing else, so the devices' films
 // add up to the whole render however the blocks fell. Thread-safe.
@@ -91,7 +91,7 @@ struct RenderOptions {
   int warmup = 0;         // untimed renders before the timed one, on every backend
   int64_t wave_size = 0;  // wavefront path slots; 0 chooses (queues/wave.hpp)
   int threads = 0;        // CPU threads; 0 uses every core
-  // The devices to split the render over (render/split.hpp): CUDA device indices,
+  // The devices to split the render over (dispatch/split.hpp): CUDA device indices,
   // or on the CPU backend host "devices" (each a share of the threads). None or
   // one: one device (the current CUDA device where none is named).
   std::vector<int> devices;
@@ -120,7 +120,7 @@ struct RenderOptions {
   PathFeed* path_feed = nullptr;
 };
 
-// What one device did in a render split over several (render/split.hpp).
+// What one device did in a render split over several (dispatch/split.hpp).
 struct DeviceShare {
   std::string device;  // "cuda:1", "cpu:0"
   std::string name;    // what the backend calls it ("NVIDIA H200", "CPU (8 threads)")
