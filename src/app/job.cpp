@@ -177,78 +177,232 @@ std::string render_signature(const JobOutcome& o) {
 
 JobOutcome run_job(const Job& job) { return run_job(job, Cluster()); }
 
-JobOutcome run_job(const Job& job, const Cluster& cluster) {
-  const auto job_start = std::chrono::steady_clock::now();
-  JobOutcome out;
-  const bool distributed = cluster.distributed();
-  // The CUDA context starts while the scene loads: that of the first device the job
-  // renders on (a batch lane's job starts none on another lane's device). A bad
-  // device list is left for the render's own parse below to report.
-  std::thread context;
-  if (job.backend != "cpu") {
-    context = std::thread([&job] {
+namespace {
+
+// The CUDA context starts while the scene loads: that of the first device the job
+// renders on (a batch lane's job starts none on another lane's device). A bad device
+// list is left for the render's own parse to report.
+class ContextStart {
+ public:
+  explicit ContextStart(const Job& job) {
+    if (job.backend == "cpu") return;
+    thread_ = std::thread([devices = job.devices] {
       int first = 0;
       try {
-        const std::vector<int> devices = parse_devices(job.devices, Backend::Cuda, cuda::device_count());
-        if (!devices.empty()) first = devices[0];
+        const std::vector<int> list = parse_devices(devices, Backend::Cuda, cuda::device_count());
+        if (!list.empty()) first = list[0];
       } catch (const InputError&) {
       }
       cuda::start_context(first);
     });
   }
-  struct Joined {
-    std::thread& t;
-    ~Joined() {
-      if (t.joinable()) t.join();
-    }
-  } joined{context};
+  ~ContextStart() {
+    if (thread_.joinable()) thread_.join();
+  }
+  ContextStart(const ContextStart&) = delete;
+  ContextStart& operator=(const ContextStart&) = delete;
 
+ private:
+  std::thread thread_;
+};
+
+// Every file the job writes, checked before the scene loads: a bad path costs
+// nothing, and no output may overwrite another. Of an MPI run, rank 0 alone writes
+// (and keeps no checkpoint).
+void check_outputs(const Job& job, bool distributed) {
+  check_output_path(job.output);
+  if (!job.stats.empty()) check_output_path_for_text(job.stats);
+  check_distinct_files(job);
+  check_creatable(job.output, "image");
+  if (!job.stats.empty()) check_creatable(job.stats, "stats file");
+  if (!distributed && !checkpoint_of(job).empty()) {
+    check_output_folder(checkpoint_of(job));
+    check_creatable(checkpoint_of(job), job.checkpoint.empty() ? "resume file (written back to)" : "checkpoint");
+  }
+}
+
+// The render's options from the job and its scene.
+RenderOptions resolve_options(const Job& job, const Scene& scene) {
+  RenderOptions options;
+  options.params = resolve_params(scene, job);
+  options.kernel = parse_kernel(job.kernel);
+  options.backend = parse_backend(job.backend);
+  options.warmup = static_cast<int>(job.warmup);
+  options.wave_size = job.wave_size;
+  options.threads = static_cast<int>(job.threads);
+  options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
+  return options;
+}
+
+// Of an MPI run: this rank's share of its host's devices or cores (and no checkpoint).
+void take_rank_share(const Job& job, const Cluster& cluster, RenderOptions& options) {
+  if (!job.checkpoint.empty() || !job.resume.empty()) {
+    throw InputError(std::string(job.checkpoint.empty() ? "resume" : "checkpoint") +
+                     ": checkpoints are kept by one process; a render over " + std::to_string(cluster.ranks()) +
+                     " MPI ranks has none (render its parts as jobs of a batch instead)");
+  }
+  if (options.backend == Backend::Cuda) {
+    // The ranks of one host share its GPUs out (parse_devices lists them all for "all").
+    options.devices = local_share(options.devices, cluster.local_rank(), cluster.local_ranks());
+  } else if (options.threads == 0) {
+    // The ranks of one host share its cores out.
+    options.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / cluster.local_ranks());
+  }
+}
+
+// The first phase: the outputs checked, the scene loaded, the options resolved.
+void load_job(const Job& job, const Cluster& cluster, JobOutcome& out, std::optional<Scene>& scene,
+              RenderOptions& options) {
+  if (cluster.root()) check_outputs(job, cluster.distributed());
+  scene.emplace(load_scene(job.scene));
+  out.load_times = scene->load_times;
+  out.geometry = scene->summary();
+  options = resolve_options(job, *scene);
+  out.params = options.params;
+  out.backend = backend_name(options.backend);
+  out.kernel = kernel_name(options.kernel);
+  if (cluster.distributed()) take_rank_share(job, cluster, options);
+}
+
+// What a render with a checkpoint keeps while it runs.
+struct CheckpointState {
+  Checkpoint resumed;
+  std::optional<SignalCatcher> signals;
+  // Once a pass says stop, the render ends as it is: its progress line stays where it was.
+  std::atomic<bool> stopping{false};
+};
+
+// Locks the job's checkpoint (held until the image is written), resumes from the one
+// there is, and has the render write it every checkpoint_every seconds and when a
+// signal stops it, in passes short enough that a signal is answered within about
+// 1/256 of the render.
+void watch_checkpoint(const Job& job, const JobOutcome& out, RenderOptions& options, CheckpointState& state,
+                      CheckpointLock& lock) {
+  const RenderParams& rp = options.params;
+  const std::string& path = checkpoint_of(job);
+  lock = CheckpointLock(path);
+  const CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
+  const std::string from =
+      !job.resume.empty() ? job.resume : (std::filesystem::exists(job.checkpoint) ? job.checkpoint : "");
+  if (!from.empty()) {
+    state.resumed = read_checkpoint(from);
+    require_same_render(from, state.resumed.identity, identity);
+    options.first_sample = state.resumed.samples;
+    options.initial_film = &state.resumed.film;
+  }
+  options.samples_per_pass = std::max(1, rp.spp / 256);
+  state.signals.emplace();
+  options.after_pass = [&state, &job, &path, spp = rp.spp, identity, last_write = std::chrono::steady_clock::now()](
+                           int32_t samples, const FilmReader& film) mutable {
+    const bool stop = state.signals->caught() != 0;
+    if (stop) state.stopping = true;
+    const auto now = std::chrono::steady_clock::now();
+    if (stop || (samples < spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {
+      write_checkpoint(path, Checkpoint{identity, samples, film()});
+      last_write = now;
+    }
+    return !stop;
+  };
+}
+
+// The second phase, in one process: the render, from and into its checkpoint where
+// the job has one.
+void render_alone(const Job& job, const Scene& scene, RenderOptions& options, JobOutcome& out, CheckpointLock& lock) {
+  const RenderParams& rp = options.params;
+  // Checkpoints go to job.checkpoint, or back into the file resumed from.
+  const std::string& checkpoint_path = checkpoint_of(job);
+  CheckpointState state;
+  if (!checkpoint_path.empty()) {
+    watch_checkpoint(job, out, options, state, lock);
+    out.resumed_from_sample = state.resumed.samples;
+  }
+  if (state.resumed.samples >= rp.spp && !state.resumed.film.empty()) {
+    // Every sample was done before: the image is the checkpoint's film.
+    out.result.rgb = state.resumed.film;
+    out.result.samples = rp.spp;
+    take_mean(out.result);
+  } else {
+    ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
+    if (job.progress) {
+      options.progress = [&state, draw = progress.callback()](double done, uint64_t rays, double seconds) {
+        if (!state.stopping) draw(done, rays, seconds);
+      };
+    }
+    out.result = render(scene, options);
+  }
+  if (out.result.interrupted) {
+    const int sig = state.signals->caught();
+    out.exit_code = 128 + sig;
+    out.message = "interrupted by " + signal_name(sig) + " at sample " + std::to_string(out.result.samples) + " of " +
+                  std::to_string(rp.spp) + "; checkpoint written to " + checkpoint_path + " (resume with --resume " +
+                  checkpoint_path + ")";
+  }
+  // The image is about to be written: the checkpoint has served its purpose once it is.
+  out.checkpoint = checkpoint_path;
+}
+
+// The second phase as a rank of an MPI run: this rank's samples' sums (rank 0 adds
+// the others' to its own).
+void render_rank(const Job& job, const Scene& scene, RenderOptions& options, const Cluster& cluster,
+                 JobOutcome& out) {
+  const RenderParams& rp = options.params;
+  if (options.sample_count == 0) {
+    out.result.rgb.assign(static_cast<size_t>(rp.width) * rp.height * 3, 0.0f);
+    out.result.device = "no samples";
+    return;
+  }
+  ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * options.sample_count);
+  if (job.progress && cluster.root()) options.progress = progress.callback();  // rank 0's part
+  out.result = render_sums(scene, options);
+}
+
+// Says so where pixels are not finite (the stats count them too).
+void warn_nonfinite(const Job& job, JobOutcome& out) {
+  out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
+  if (out.nonfinite_pixels == 0) return;
+  std::fprintf(stderr, "wavetrace: %s: warning: %llu pixels are not finite (NaN or an infinity); %s\n",
+               job.output.c_str(), static_cast<unsigned long long>(out.nonfinite_pixels),
+               is_png(job.output) ? "the PNG holds them as 0 (NaN) and 255 (infinity)"
+                                  : "the image holds them as they are");
+}
+
+// The last phase: the image and the stats written, the checkpoint removed.
+void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
+               std::chrono::steady_clock::time_point job_start) {
+  warn_nonfinite(job, out);
+  // Both files are written in full before either takes its name: a disk that fills
+  // up during the second leaves neither.
+  const auto write_start = std::chrono::steady_clock::now();
+  StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
+                                 job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
+  const auto written = std::chrono::steady_clock::now();
+  out.write_seconds = std::chrono::duration<double>(written - write_start).count();
+  out.job_seconds = std::chrono::duration<double>(written - job_start).count();
+  StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
+  image.commit();
+  stats.commit();
+  // The image is written: the checkpoint has served its purpose.
+  if (!out.checkpoint.empty()) std::filesystem::remove(out.checkpoint);
+  if (job.profile) {
+    print_load_times(out.load_times, out.result.upload_seconds);
+    print_geometry(out.geometry);
+    print_profile(out.result);
+  }
+}
+
+}  // namespace
+
+JobOutcome run_job(const Job& job, const Cluster& cluster) {
+  const auto job_start = std::chrono::steady_clock::now();
+  JobOutcome out;
+  const bool distributed = cluster.distributed();
+  const ContextStart context(job);
   std::optional<Scene> scene;
   RenderOptions options;
   // Held from before the checkpoint is read until the image is written.
   CheckpointLock checkpoint_lock;
-  guarded(out, [&] {
-    // Of an MPI run, rank 0 alone writes. Every file the job writes is checked before
-    // the scene loads: a bad path costs nothing, and no output may overwrite another.
-    if (cluster.root()) {
-      check_output_path(job.output);
-      if (!job.stats.empty()) check_output_path_for_text(job.stats);
-      check_distinct_files(job);
-      check_creatable(job.output, "image");
-      if (!job.stats.empty()) check_creatable(job.stats, "stats file");
-      if (!distributed && !checkpoint_of(job).empty()) {
-        check_output_folder(checkpoint_of(job));
-        check_creatable(checkpoint_of(job), job.checkpoint.empty() ? "resume file (written back to)" : "checkpoint");
-      }
-    }
-    scene.emplace(load_scene(job.scene));
-    out.load_times = scene->load_times;
-    out.geometry = scene->summary();
-    options.params = resolve_params(*scene, job);
-    options.kernel = parse_kernel(job.kernel);
-    options.backend = parse_backend(job.backend);
-    options.warmup = static_cast<int>(job.warmup);
-    options.wave_size = job.wave_size;
-    options.threads = static_cast<int>(job.threads);
-    options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
-    out.params = options.params;
-    out.backend = backend_name(options.backend);
-    out.kernel = kernel_name(options.kernel);
-    if (distributed) {
-      if (!job.checkpoint.empty() || !job.resume.empty()) {
-        throw InputError(std::string(job.checkpoint.empty() ? "resume" : "checkpoint") +
-                         ": checkpoints are kept by one process; a render over " + std::to_string(cluster.ranks()) +
-                         " MPI ranks has none (render its parts as jobs of a batch instead)");
-      }
-      if (options.backend == Backend::Cuda) {
-        // The ranks of one host share its GPUs out (parse_devices lists them all for "all").
-        options.devices = local_share(options.devices, cluster.local_rank(), cluster.local_ranks());
-      } else if (options.threads == 0) {
-        // The ranks of one host share its cores out.
-        options.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / cluster.local_ranks());
-      }
-    }
-  });
+  // Each phase guarded, so that every rank of an MPI run reaches every exchange.
+  guarded(out, [&] { load_job(job, cluster, out, scene, options); });
   if (distributed) {
     const double weight = options.backend == Backend::Cuda ? std::max<size_t>(1, options.devices.size())
                                                            : std::max(1, options.threads);
@@ -257,113 +411,21 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   }
   const auto started = std::chrono::steady_clock::now();
   if (out.exit_code != 0) return out;
-
   guarded(out, [&] {
-    const RenderParams& rp = options.params;
     if (distributed) {
-      // This rank's samples; rank 0 adds the others' sums to its own.
-      if (options.sample_count > 0) {
-        ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * options.sample_count);
-        if (job.progress && cluster.root()) options.progress = progress.callback();  // rank 0's part
-        out.result = render_sums(*scene, options);
-      } else {
-        out.result.rgb.assign(static_cast<size_t>(rp.width) * rp.height * 3, 0.0f);
-        out.result.device = "no samples";
-      }
-      return;
-    }
-    // Checkpoints go to job.checkpoint, or back into the file resumed from.
-    const std::string& checkpoint_path = checkpoint_of(job);
-    Checkpoint resumed;
-    std::optional<SignalCatcher> signals;
-    // Once a pass says stop, the render ends as it is: its progress line stays where it was.
-    std::atomic<bool> stopping{false};
-    if (!checkpoint_path.empty()) {
-      checkpoint_lock = CheckpointLock(checkpoint_path);
-      const CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
-      const std::string from =
-          !job.resume.empty() ? job.resume : (std::filesystem::exists(job.checkpoint) ? job.checkpoint : "");
-      if (!from.empty()) {
-        resumed = read_checkpoint(from);
-        require_same_render(from, resumed.identity, identity);
-        options.first_sample = resumed.samples;
-        options.initial_film = &resumed.film;
-        out.resumed_from_sample = resumed.samples;
-      }
-      // Short passes, so that a signal is answered within about 1/256 of the render.
-      options.samples_per_pass = std::max(1, rp.spp / 256);
-      signals.emplace();
-      options.after_pass = [&, identity, last_write = std::chrono::steady_clock::now()](
-                               int32_t samples, const FilmReader& film) mutable {
-        const bool stop = signals->caught() != 0;
-        if (stop) stopping = true;
-        const auto now = std::chrono::steady_clock::now();
-        if (stop || (samples < rp.spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {
-          write_checkpoint(checkpoint_path, Checkpoint{identity, samples, film()});
-          last_write = now;
-        }
-        return !stop;
-      };
-    }
-
-    if (resumed.samples >= rp.spp && !resumed.film.empty()) {
-      // Every sample was done before: the image is the checkpoint's film.
-      out.result.rgb = resumed.film;
-      out.result.samples = rp.spp;
-      take_mean(out.result);
+      render_rank(job, *scene, options, cluster, out);
     } else {
-      ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
-      if (job.progress) {
-        options.progress = [&stopping, draw = progress.callback()](double done, uint64_t rays, double seconds) {
-          if (!stopping) draw(done, rays, seconds);
-        };
-      }
-      out.result = render(*scene, options);
+      render_alone(job, *scene, options, out, checkpoint_lock);
     }
-    if (out.result.interrupted) {
-      const int sig = signals->caught();
-      out.exit_code = 128 + sig;
-      out.message = "interrupted by " + signal_name(sig) + " at sample " + std::to_string(out.result.samples) +
-                    " of " + std::to_string(rp.spp) + "; checkpoint written to " + checkpoint_path +
-                    " (resume with --resume " + checkpoint_path + ")";
-    }
-    // The image is about to be written: the checkpoint has served its purpose once it is.
-    out.checkpoint = checkpoint_path;
   });
   if (distributed) {
     combine_results(cluster, out);
     out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   }
   if (out.exit_code != 0 || !cluster.root()) return out;
-
   guarded(out, [&] {
     if (distributed) take_mean(out.result);
-    // Both files are written in full before either takes its name: a disk that fills
-    // up during the second leaves neither.
-    out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
-    if (out.nonfinite_pixels > 0) {
-      std::fprintf(stderr,
-                   "wavetrace: %s: warning: %llu pixels are not finite (NaN or an infinity); %s\n", job.output.c_str(),
-                   static_cast<unsigned long long>(out.nonfinite_pixels),
-                   is_png(job.output) ? "the PNG holds them as 0 (NaN) and 255 (infinity)"
-                                      : "the image holds them as they are");
-    }
-    const auto write_start = std::chrono::steady_clock::now();
-    StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
-                                   job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
-    const auto written = std::chrono::steady_clock::now();
-    out.write_seconds = std::chrono::duration<double>(written - write_start).count();
-    out.job_seconds = std::chrono::duration<double>(written - job_start).count();
-    StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
-    image.commit();
-    stats.commit();
-    // The image is written: the checkpoint has served its purpose.
-    if (!out.checkpoint.empty()) std::filesystem::remove(out.checkpoint);
-    if (job.profile) {
-      print_load_times(out.load_times, out.result.upload_seconds);
-      print_geometry(out.geometry);
-      print_profile(out.result);
-    }
+    write_job(job, options, out, job_start);
   });
   return out;
 }
