@@ -117,16 +117,8 @@ std::string utc_now() {
   return buf;
 }
 
-}  // namespace
-
-int run_bench(const BenchOptions& options) {
-  BenchSpec spec = read_bench_spec(options.spec, options.only);
-  if (options.repeats > 0) spec.repeats = options.repeats;
-  const Backend backend = parse_backend(options.backend);
-  std::error_code ec;
-  fs::create_directories(options.out_dir, ec);
-  check_output_folder((fs::path(options.out_dir) / "results.json").string());
-
+// What the results say of the run as a whole.
+json results_header(const BenchOptions& options, const BenchSpec& spec, Backend backend) {
   json results;
   results["date"] = utc_now();
   results["commit"] = options.commit;
@@ -138,8 +130,101 @@ int run_bench(const BenchOptions& options) {
   results["check"] = {{"spp", spec.check_spp}, {"max_mean_abs_diff", spec.check_bound}, {"against", "megakernel"}};
   results["kernels"] = kernel_names();
   results["points"] = json::array();
-  std::vector<std::string> stages;  // the wavefront's stages, in the order they run
+  return results;
+}
 
+// The timed runs of one kernel at one point, into its row: their seconds, and the
+// counts and stage times of the run whose time is the median.
+void time_kernel(const Scene& scene, RenderOptions o, const BenchSpec& spec, json& row,
+                 std::vector<std::string>& stages, double diff) {
+  std::vector<double> seconds;
+  std::vector<RenderResult> runs;
+  for (int r = 0; r < spec.repeats; ++r) {
+    o.warmup = r == 0 ? spec.warmup : 0;
+    runs.push_back(render(scene, o));
+    runs.back().rgb.clear();
+    seconds.push_back(runs.back().seconds);
+    std::fprintf(stderr, "    run %d/%d: %.3f s\n", r + 1, spec.repeats, seconds.back());
+  }
+  std::vector<size_t> order(runs.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return seconds[a] < seconds[b]; });
+  const RenderResult& kept = runs[order[order.size() / 2]];
+  const double med = median(seconds);
+  row["status"] = "ok";
+  row["seconds"] = seconds;
+  row["seconds_median"] = med;
+  row["seconds_min"] = *std::min_element(seconds.begin(), seconds.end());
+  row["seconds_max"] = *std::max_element(seconds.begin(), seconds.end());
+  add_measurements(row, kept, med, scene.load_times);
+  row["geometry"] = geometry_json(scene.summary());
+  for (const StageTime& st : kept.stages) {
+    if (std::find(stages.begin(), stages.end(), st.name) == stages.end()) stages.push_back(st.name);
+  }
+  std::fprintf(stderr, "    median %.3f s, %.1f M rays/s, %.1f M paths/s, check diff %.2e\n", med,
+               kept.rays / med / 1e6, kept.paths / med / 1e6, diff);
+}
+
+// One kernel at one point: checked against the megakernel's image at the check's
+// samples (a kernel that renders another image is not timed), then timed. False
+// where it failed.
+bool bench_kernel(const Scene& scene, const BenchPoint& p, const std::string& kname, const RenderOptions& check,
+                  const RenderResult& reference, const BenchSpec& spec, json& row, std::vector<std::string>& stages) {
+  try {
+    RenderOptions o;
+    o.backend = check.backend;
+    o.kernel = parse_kernel(kname);
+    o.params = check.params;
+    const RenderResult probe = render(scene, o);
+    const double diff = mean_abs_diff(reference.rgb, probe.rgb);
+    const bool passed = diff <= spec.check_bound;
+    row["check"] = {{"mean_abs_diff", diff}, {"passed", passed}, {"rays", probe.rays},
+                    {"reference_rays", reference.rays}};
+    if (!passed) {
+      row["status"] = "image differs from the megakernel's";
+      return false;
+    }
+    o.params = p.params;
+    time_kernel(scene, o, spec, row, stages, diff);
+    return true;
+  } catch (const std::exception& e) {
+    row["status"] = std::string("error: ") + e.what();
+    std::fprintf(stderr, "    %s\n", e.what());
+    return false;
+  }
+}
+
+// results.csv: a line a row.
+std::string results_csv(const json& results) {
+  std::ostringstream csv;
+  csv << "group,scene,width,height,spp,depth,kernel,status,seconds_median,seconds_min,seconds_max,rays,paths,"
+         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff,shadow_rays\n";
+  for (const json& r : results["points"]) {
+    csv << r["group"].get<std::string>() << "," << fs::path(r["scene"].get<std::string>()).filename().string() << ","
+        << r["width"] << "," << r["height"] << "," << r["spp"] << "," << r["depth"] << ","
+        << r["kernel"].get<std::string>() << "," << r["status"].get<std::string>().substr(0, 40) << ","
+        << r.value("seconds_median", 0.0) << "," << r.value("seconds_min", 0.0) << "," << r.value("seconds_max", 0.0)
+        << "," << r.value("rays", uint64_t(0)) << "," << r.value("paths", uint64_t(0)) << ","
+        << r.value("m_rays_per_s", 0.0) << "," << r.value("m_paths_per_s", 0.0) << ","
+        << r.value("rays_per_path", 0.0) << ","
+        << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << ","
+        << r.value("shadow_rays", uint64_t(0)) << "\n";
+  }
+  return csv.str();
+}
+
+}  // namespace
+
+int run_bench(const BenchOptions& options) {
+  BenchSpec spec = read_bench_spec(options.spec, options.only);
+  if (options.repeats > 0) spec.repeats = options.repeats;
+  const Backend backend = parse_backend(options.backend);
+  std::error_code ec;
+  fs::create_directories(options.out_dir, ec);
+  check_output_folder((fs::path(options.out_dir) / "results.json").string());
+
+  json results = results_header(options, spec, backend);
+  std::vector<std::string> stages;  // the wavefront's stages, in the order they run
   size_t total = 0, done = 0;
   for (const BenchPoint& p : spec.points) total += p.kernels.size();
   int failures = 0;
@@ -161,77 +246,13 @@ int run_bench(const BenchOptions& options) {
       std::fprintf(stderr, "[%zu/%zu] %s %s %dx%d %d spp depth %d %s\n", done, total, p.group.c_str(),
                    fs::path(p.scene).filename().c_str(), p.params.width, p.params.height, p.params.spp,
                    p.params.depth, kname.c_str());
-      try {
-        RenderOptions o;
-        o.backend = backend;
-        o.kernel = parse_kernel(kname);
-        o.params = check.params;
-        RenderResult probe = render(scene, o);
-        double diff = mean_abs_diff(reference.rgb, probe.rgb);
-        bool passed = diff <= spec.check_bound;
-        row["check"] = {{"mean_abs_diff", diff}, {"passed", passed}, {"rays", probe.rays},
-                        {"reference_rays", reference.rays}};
-        if (!passed) {
-          ++failures;
-          row["status"] = "image differs from the megakernel's";
-          results["points"].push_back(row);
-          continue;
-        }
-        o.params = p.params;
-        std::vector<double> seconds;
-        std::vector<RenderResult> runs;
-        for (int r = 0; r < spec.repeats; ++r) {
-          o.warmup = r == 0 ? spec.warmup : 0;
-          runs.push_back(render(scene, o));
-          runs.back().rgb.clear();
-          seconds.push_back(runs.back().seconds);
-          std::fprintf(stderr, "    run %d/%d: %.3f s\n", r + 1, spec.repeats, seconds.back());
-        }
-        // Counts and stage times come from the run whose time is the median.
-        std::vector<size_t> order(runs.size());
-        for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return seconds[a] < seconds[b]; });
-        const RenderResult& kept = runs[order[order.size() / 2]];
-        const double med = median(seconds);
-        row["status"] = "ok";
-        row["seconds"] = seconds;
-        row["seconds_median"] = med;
-        row["seconds_min"] = *std::min_element(seconds.begin(), seconds.end());
-        row["seconds_max"] = *std::max_element(seconds.begin(), seconds.end());
-        add_measurements(row, kept, med, scene.load_times);
-        row["geometry"] = geometry_json(scene.summary());
-        for (const StageTime& st : kept.stages) {
-          if (std::find(stages.begin(), stages.end(), st.name) == stages.end()) stages.push_back(st.name);
-        }
-        std::fprintf(stderr, "    median %.3f s, %.1f M rays/s, %.1f M paths/s, check diff %.2e\n", med,
-                     kept.rays / med / 1e6, kept.paths / med / 1e6, diff);
-      } catch (const std::exception& e) {
-        ++failures;
-        row["status"] = std::string("error: ") + e.what();
-        std::fprintf(stderr, "    %s\n", e.what());
-      }
+      if (!bench_kernel(scene, p, kname, check, reference, spec, row, stages)) ++failures;
       results["points"].push_back(row);
     }
   }
-
   results["stages"] = stages;
-
-  std::ostringstream csv;
-  csv << "group,scene,width,height,spp,depth,kernel,status,seconds_median,seconds_min,seconds_max,rays,paths,"
-         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff,shadow_rays\n";
-  for (const json& r : results["points"]) {
-    csv << r["group"].get<std::string>() << "," << fs::path(r["scene"].get<std::string>()).filename().string() << ","
-        << r["width"] << "," << r["height"] << "," << r["spp"] << "," << r["depth"] << ","
-        << r["kernel"].get<std::string>() << "," << r["status"].get<std::string>().substr(0, 40) << ","
-        << r.value("seconds_median", 0.0) << "," << r.value("seconds_min", 0.0) << "," << r.value("seconds_max", 0.0)
-        << "," << r.value("rays", uint64_t(0)) << "," << r.value("paths", uint64_t(0)) << ","
-        << r.value("m_rays_per_s", 0.0) << "," << r.value("m_paths_per_s", 0.0) << ","
-        << r.value("rays_per_path", 0.0) << ","
-        << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << ","
-        << r.value("shadow_rays", uint64_t(0)) << "\n";
-  }
   write_file((fs::path(options.out_dir) / "results.json").string(), results.dump(1) + "\n");
-  write_file((fs::path(options.out_dir) / "results.csv").string(), csv.str());
+  write_file((fs::path(options.out_dir) / "results.csv").string(), results_csv(results));
   std::fprintf(stderr, "bench: %zu points, %d failed; results in %s\n", total, failures, options.out_dir.c_str());
   return failures ? kExitFailure : 0;
 }
