@@ -61,6 +61,53 @@ int64_t whole_number(const std::string& path, const json& value, const std::stri
   return v;
 }
 
+// The header's identity and samples, each field checked.
+void read_header(const std::string& path, const std::string& text, Checkpoint& c) {
+  try {
+    const json header = json::parse(text);
+    c.identity.scene = header.at("scene").get<std::string>();
+    c.identity.scene_crc = header.at("scene_crc32").get<uint32_t>();
+    for (SettingId s : render_settings()) {
+      const Setting& info = setting(s);
+      set_param(c.identity.params, s, whole_number(path, header.at("settings").at(info.key), info.key, info.lo, info.hi));
+    }
+    c.identity.kernel = header.at("kernel").get<std::string>();
+    c.identity.backend = header.at("backend").get<std::string>();
+    c.identity.renderer = header.at("renderer").get<std::string>();
+    c.samples = static_cast<int32_t>(whole_number(path, header.at("samples"), "samples", 0, c.identity.params.spp));
+  } catch (const nlohmann::json::exception& e) {
+    damaged(path, std::string("its header cannot be read (") + e.what() + ")");
+  }
+}
+
+// The film that follows the header at byte `at`: the render's size, every value a
+// sum of radiance (which is never negative, so neither is a sum of samples of it).
+void read_film(const std::string& path, const std::string& bytes, size_t at, Checkpoint& c) {
+  uint64_t floats = 0;
+  std::memcpy(&floats, bytes.data() + at, sizeof floats);
+  const uint64_t expected = uint64_t{3} * static_cast<uint64_t>(c.identity.params.width) *
+                            static_cast<uint64_t>(c.identity.params.height);
+  if (floats != expected) {
+    damaged(path, "its film holds " + std::to_string(floats) + " values; a " + std::to_string(c.identity.params.width) +
+                      " x " + std::to_string(c.identity.params.height) + " render's holds " + std::to_string(expected));
+  }
+  if (at + sizeof floats + floats * sizeof(float) + sizeof(uint32_t) != bytes.size()) {
+    damaged(path, "its film is not the size its header says");
+  }
+  c.film.resize(floats);
+  std::memcpy(c.film.data(), bytes.data() + at + sizeof floats, floats * sizeof(float));
+  for (size_t i = 0; i < c.film.size(); ++i) {
+    const float v = c.film[i];
+    if (!std::isfinite(v) || v < 0.0f) {
+      const size_t pixel = i / 3;
+      const size_t w = static_cast<size_t>(c.identity.params.width);
+      damaged(path, "its film's pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) + ") holds " +
+                        (std::isnan(v) ? std::string("NaN") : std::isinf(v) ? "an infinity" : std::to_string(v)) +
+                        "; a sum of radiance is finite and at least 0");
+    }
+  }
+}
+
 }  // namespace
 
 CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
@@ -112,46 +159,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   }
   if (fixed + header_bytes + sizeof(uint64_t) + sizeof(uint32_t) > bytes.size()) damaged(path, "its header is cut short");
   Checkpoint c;
-  try {
-    const json header = json::parse(bytes.substr(fixed, header_bytes));
-    c.identity.scene = header.at("scene").get<std::string>();
-    c.identity.scene_crc = header.at("scene_crc32").get<uint32_t>();
-    for (SettingId s : render_settings()) {
-      const Setting& info = setting(s);
-      set_param(c.identity.params, s, whole_number(path, header.at("settings").at(info.key), info.key, info.lo, info.hi));
-    }
-    c.identity.kernel = header.at("kernel").get<std::string>();
-    c.identity.backend = header.at("backend").get<std::string>();
-    c.identity.renderer = header.at("renderer").get<std::string>();
-    c.samples = static_cast<int32_t>(whole_number(path, header.at("samples"), "samples", 0, c.identity.params.spp));
-  } catch (const nlohmann::json::exception& e) {
-    damaged(path, std::string("its header cannot be read (") + e.what() + ")");
-  }
-  uint64_t floats = 0;
-  const size_t at = fixed + header_bytes;
-  std::memcpy(&floats, bytes.data() + at, sizeof floats);
-  const uint64_t expected = uint64_t{3} * static_cast<uint64_t>(c.identity.params.width) *
-                            static_cast<uint64_t>(c.identity.params.height);
-  if (floats != expected) {
-    damaged(path, "its film holds " + std::to_string(floats) + " values; a " + std::to_string(c.identity.params.width) +
-                      " x " + std::to_string(c.identity.params.height) + " render's holds " + std::to_string(expected));
-  }
-  if (at + sizeof floats + floats * sizeof(float) + sizeof(uint32_t) != bytes.size()) {
-    damaged(path, "its film is not the size its header says");
-  }
-  c.film.resize(floats);
-  std::memcpy(c.film.data(), bytes.data() + at + sizeof floats, floats * sizeof(float));
-  // Radiance is never negative, so neither is a sum of samples of it.
-  for (size_t i = 0; i < c.film.size(); ++i) {
-    const float v = c.film[i];
-    if (!std::isfinite(v) || v < 0.0f) {
-      const size_t pixel = i / 3;
-      const size_t w = static_cast<size_t>(c.identity.params.width);
-      damaged(path, "its film's pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) + ") holds " +
-                        (std::isnan(v) ? std::string("NaN") : std::isinf(v) ? "an infinity" : std::to_string(v)) +
-                        "; a sum of radiance is finite and at least 0");
-    }
-  }
+  read_header(path, bytes.substr(fixed, header_bytes), c);
+  read_film(path, bytes, fixed + header_bytes, c);
   return c;
 }
 
