@@ -233,95 +233,116 @@ class MaterialLibraries : public tinyobj::MaterialReader {
 // before it parses it: every number of a v, vt or vn line finite and in float range,
 // every index of an f, l or p line a whole number that names an element of the file.
 // An error names the line.
-void check_obj_numbers(const std::string& text, const std::string& path) {
+class ObjNumbers {
+ public:
+  explicit ObjNumbers(const std::string& path) : path_(path) {}
+
+  void check(const std::string& text) {
+    size_t at = 0;
+    std::vector<std::string_view> words;
+    while (at < text.size()) {
+      const size_t end = std::min(text.find('\n', at), text.size());
+      std::string_view rest(text.data() + at, end - at);
+      at = end + 1;
+      ++line_;
+      split(rest.substr(0, rest.find('#')), words);
+      if (words.empty()) continue;
+      const std::string_view command = words[0];
+      const int kind = command == "v" ? kV : command == "vt" ? kVt : command == "vn" ? kVn : -1;
+      if (kind >= 0) {
+        numbers(kind, words);
+      } else if (command == "f" || command == "l" || command == "p") {
+        for (size_t w = 1; w < words.size(); ++w) corner(command, words[w]);
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (static_cast<uint64_t>(largest_[k]) > count_[k]) {
+        fail_at(largest_line_[k], "index " + std::to_string(largest_[k]) + " is out of range: the file has " +
+                                      std::to_string(count_[k]) + " " + kKinds[k] + (count_[k] == 1 ? "" : "s"));
+      }
+    }
+  }
+
+ private:
   enum { kV, kVt, kVn };
-  size_t count[3] = {0, 0, 0};
-  int64_t largest[3] = {0, 0, 0};  // the largest index given, and its line
-  size_t largest_line[3] = {0, 0, 0};
-  static const char* const kKinds[3] = {"vertex position", "texture coordinate", "normal"};
-  const auto line_error = [&](size_t line, const std::string& what) {
-    fail(path, "malformed OBJ: line " + std::to_string(line) + ": " + what);
-  };
-  size_t at = 0, line = 0;
-  std::vector<std::string_view> words;
-  while (at < text.size()) {
-    const size_t end = std::min(text.find('\n', at), text.size());
-    std::string_view rest(text.data() + at, end - at);
-    at = end + 1;
-    ++line;
-    rest = rest.substr(0, rest.find('#'));
+  static constexpr const char* kKinds[3] = {"vertex position", "texture coordinate", "normal"};
+
+  [[noreturn]] void fail_at(size_t line, const std::string& what) const {
+    fail(path_, "malformed OBJ: line " + std::to_string(line) + ": " + what);
+  }
+
+  static void split(std::string_view line, std::vector<std::string_view>& words) {
     words.clear();
-    for (size_t i = 0; i < rest.size();) {
-      const size_t begin = rest.find_first_not_of(" \t\r\v\f", i);
+    for (size_t i = 0; i < line.size();) {
+      const size_t begin = line.find_first_not_of(" \t\r\v\f", i);
       if (begin == std::string_view::npos) break;
-      const size_t stop = std::min(rest.find_first_of(" \t\r\v\f", begin), rest.size());
-      words.push_back(rest.substr(begin, stop - begin));
+      const size_t stop = std::min(line.find_first_of(" \t\r\v\f", begin), line.size());
+      words.push_back(line.substr(begin, stop - begin));
       i = stop;
     }
-    if (words.empty()) continue;
-    const std::string_view command = words[0];
-    const int kind = command == "v" ? kV : command == "vt" ? kVt : command == "vn" ? kVn : -1;
-    if (kind >= 0) {
-      // v: x y z, then w or r g b (and w); vt: u, v, w; vn: x y z.
-      const size_t lo = kind == kVt ? 1 : 3, hi = kind == kV ? 7 : 3;
-      const size_t n = words.size() - 1;
-      if (n < lo || n > hi) {
-        line_error(line, std::string(command) + " needs " + (lo == hi ? std::to_string(lo) : std::to_string(lo) + " to " +
-                                                                                     std::to_string(hi)) +
-                             " numbers (got " + std::to_string(n) + ")");
-      }
-      for (size_t w = 1; w < words.size(); ++w) {
-        const std::string word(words[w]);
-        char* stop = nullptr;
-        const double v = std::strtod(word.c_str(), &stop);
-        if (stop != word.c_str() + word.size() || !std::isfinite(v) ||
-            std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max())) {
-          line_error(line, std::string(command) + ": '" + word + "' is not a finite number");
-        }
-      }
-      ++count[kind];
-    } else if (command == "f" || command == "l" || command == "p") {
-      for (size_t w = 1; w < words.size(); ++w) {
-        const std::string_view corner = words[w];
-        size_t field_begin = 0;
-        for (int field = 0; field < 3 && field_begin <= corner.size(); ++field) {
-          const size_t slash = std::min(corner.find('/', field_begin), corner.size());
-          const std::string word(corner.substr(field_begin, slash - field_begin));
-          field_begin = slash + 1;
-          if (word.empty() && field > 0) continue;  // v//vn, v/vt/
-          const int k = field == 0 ? kV : field == 1 ? kVt : kVn;
-          errno = 0;
-          char* stop = nullptr;
-          const long long v = word.empty() ? 0 : std::strtoll(word.c_str(), &stop, 10);
-          if (word.empty() || stop != word.c_str() + word.size() || errno == ERANGE || v == 0) {
-            line_error(line, std::string(command) + ": '" + std::string(corner) + "' is not a corner of whole, non-zero indices");
-          }
-          if (v < 0 && static_cast<unsigned long long>(-(v + 1)) >= count[k]) {
-            line_error(line, std::string(command) + ": index " + word + " reaches before the first " + kKinds[k] +
-                                 " (" + std::to_string(count[k]) + " given so far)");
-          }
-          if (v > largest[k]) {
-            largest[k] = v;
-            largest_line[k] = line;
-          }
-        }
-        if (field_begin <= corner.size()) {
-          line_error(line, std::string(command) + ": '" + std::string(corner) + "' has more than three indices");
-        }
+  }
+
+  // A v, vt or vn line: v x y z, then w or r g b (and w); vt u, v, w; vn x y z.
+  void numbers(int kind, const std::vector<std::string_view>& words) {
+    const std::string command(words[0]);
+    const size_t lo = kind == kVt ? 1 : 3, hi = kind == kV ? 7 : 3;
+    const size_t n = words.size() - 1;
+    if (n < lo || n > hi) {
+      fail_at(line_, command + " needs " +
+                         (lo == hi ? std::to_string(lo) : std::to_string(lo) + " to " + std::to_string(hi)) +
+                         " numbers (got " + std::to_string(n) + ")");
+    }
+    for (size_t w = 1; w < words.size(); ++w) {
+      const std::string word(words[w]);
+      char* stop = nullptr;
+      const double v = std::strtod(word.c_str(), &stop);
+      if (stop != word.c_str() + word.size() || !std::isfinite(v) ||
+          std::fabs(v) > static_cast<double>(std::numeric_limits<float>::max())) {
+        fail_at(line_, command + ": '" + word + "' is not a finite number");
       }
     }
+    ++count_[kind];
   }
-  for (int k = 0; k < 3; ++k) {
-    if (static_cast<uint64_t>(largest[k]) > count[k]) {
-      line_error(largest_line[k], "index " + std::to_string(largest[k]) + " is out of range: the file has " +
-                                      std::to_string(count[k]) + " " + kKinds[k] + (count[k] == 1 ? "" : "s"));
+
+  // One corner of an f, l or p line: v, v/vt, v//vn or v/vt/vn.
+  void corner(std::string_view command, std::string_view corner) {
+    size_t field_begin = 0;
+    for (int field = 0; field < 3 && field_begin <= corner.size(); ++field) {
+      const size_t slash = std::min(corner.find('/', field_begin), corner.size());
+      const std::string word(corner.substr(field_begin, slash - field_begin));
+      field_begin = slash + 1;
+      if (word.empty() && field > 0) continue;  // v//vn, v/vt/
+      const int k = field == 0 ? kV : field == 1 ? kVt : kVn;
+      errno = 0;
+      char* stop = nullptr;
+      const long long v = word.empty() ? 0 : std::strtoll(word.c_str(), &stop, 10);
+      if (word.empty() || stop != word.c_str() + word.size() || errno == ERANGE || v == 0) {
+        fail_at(line_, std::string(command) + ": '" + std::string(corner) + "' is not a corner of whole, non-zero indices");
+      }
+      if (v < 0 && static_cast<unsigned long long>(-(v + 1)) >= count_[k]) {
+        fail_at(line_, std::string(command) + ": index " + word + " reaches before the first " + kKinds[k] + " (" +
+                           std::to_string(count_[k]) + " given so far)");
+      }
+      if (v > largest_[k]) {
+        largest_[k] = v;
+        largest_line_[k] = line_;
+      }
+    }
+    if (field_begin <= corner.size()) {
+      fail_at(line_, std::string(command) + ": '" + std::string(corner) + "' has more than three indices");
     }
   }
-}
+
+  const std::string& path_;
+  size_t line_ = 0;
+  size_t count_[3] = {0, 0, 0};
+  int64_t largest_[3] = {0, 0, 0};  // the largest index given of each kind, and its line
+  size_t largest_line_[3] = {0, 0, 0};
+};
 
 void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) {
   const std::string& path = mesh.source;
-  check_obj_numbers(text, path);
+  ObjNumbers(path).check(text);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> materials;
