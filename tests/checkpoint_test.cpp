@@ -59,6 +59,27 @@ class CheckpointTest : public testing::Test {
 
   // A job on the CPU whose render runs in several passes: a wave of 1024 slots
   // makes passes of at least 4096 paths, 16 samples of 16 x 16 pixels, of 64.
+  // A job of the settings `p` (a checkpoint's) that resumes `checkpoint`.
+  Job resuming(const RenderParams& p, const std::string& output, const std::string& checkpoint) const {
+    Job j = job(output);
+    j.width = p.width;
+    j.height = p.height;
+    j.spp = p.spp;
+    j.depth = p.depth;
+    j.roulette_depth = p.roulette_depth;
+    j.seed = p.seed;
+    j.nee = p.nee;
+    j.resume = checkpoint;
+    return j;
+  }
+
+  // `c` made to hold every sample and written to done.ckpt; the job that resumes it.
+  Job resuming_finished(Checkpoint& c) const {
+    c.samples = c.identity.params.spp;
+    write_checkpoint(path("done.ckpt"), c);
+    return resuming(c.identity.params, path("done.pfm"), path("done.ckpt"));
+  }
+
   Job job(const std::string& output) const {
     Job j;
     j.scene = scene_;
@@ -185,17 +206,8 @@ TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
 
 TEST_F(CheckpointTest, ACheckpointHoldingEverySampleIsTheImage) {
   Checkpoint c = sample_checkpoint();
-  c.samples = c.identity.params.spp;
-  write_checkpoint(path("done.ckpt"), c);
-  Job j = job(path("done.pfm"));
   const RenderParams& p = c.identity.params;
-  j.width = p.width;
-  j.height = p.height;
-  j.spp = p.spp;
-  j.depth = p.depth;
-  j.roulette_depth = p.roulette_depth;
-  j.seed = p.seed;
-  j.resume = path("done.ckpt");
+  const Job j = resuming_finished(c);
   const JobOutcome o = run_job(j);
   ASSERT_EQ(o.exit_code, 0) << o.message;
   EXPECT_EQ(o.result.radiance, Radiance::MeanOfSamples);
@@ -338,18 +350,8 @@ TEST_F(CheckpointTest, AJobResumingABadCheckpointIsBadInputAndKeepsIt) {
 // than a rate of rays over 0 seconds ("-nan M rays/s").
 TEST_F(CheckpointTest, AFinishedCheckpointResumedSaysNothingWasLeftToRender) {
   Checkpoint c = sample_checkpoint();
-  c.samples = c.identity.params.spp;
-  write_checkpoint(path("done.ckpt"), c);
-  Job j = job(path("done.pfm"));
   const RenderParams& p = c.identity.params;
-  j.width = p.width;
-  j.height = p.height;
-  j.spp = p.spp;
-  j.depth = p.depth;
-  j.roulette_depth = p.roulette_depth;
-  j.seed = p.seed;
-  j.nee = p.nee;
-  j.resume = path("done.ckpt");
+  const Job j = resuming_finished(c);
   const JobOutcome o = run_job(j);
   ASSERT_EQ(o.exit_code, 0) << o.message;
   EXPECT_TRUE(fs::exists(path("done.pfm")));

@@ -30,6 +30,7 @@
 #include "scene/input_file.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
+#include "job_support.hpp"
 #include "test_support.hpp"
 
 namespace wt {
@@ -236,15 +237,7 @@ const char* kTinyScene = R"({
 })";
 
 app::Job small_job(const fs::path& dir, const std::string& scene) {
-  app::Job j;
-  j.scene = scene;
-  j.output = (dir / "out.pfm").string();
-  j.backend = "cpu";
-  j.width = 16;
-  j.height = 9;
-  j.spp = 2;
-  j.progress = false;
-  return j;
+  return test::small_job(scene, (dir / "out.pfm").string());
 }
 
 // A glTF of one triangle whose buffer is the file buffer.bin beside it.

@@ -23,6 +23,7 @@
 #include "app/job.hpp"
 #include "app/job_files.hpp"
 #include "errors/errors.hpp"
+#include "job_support.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -54,17 +55,7 @@ class JobFiles : public testing::Test {
     return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
   }
 
-  Job small_job(const std::string& output) const {
-    Job j;
-    j.scene = scene_;
-    j.output = output;
-    j.backend = "cpu";
-    j.width = 16;
-    j.height = 9;
-    j.spp = 2;
-    j.progress = false;
-    return j;
-  }
+  Job small_job(const std::string& output) const { return test::small_job(scene_, output); }
 
   // The names in the test's folder (links and folders included).
   std::set<std::string> names() const {

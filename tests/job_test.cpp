@@ -17,6 +17,7 @@
 #include "app/job.hpp"
 #include "errors/errors.hpp"
 #include "exr_support.hpp"
+#include "job_support.hpp"
 #include "test_support.hpp"
 
 namespace wt::app {
@@ -34,17 +35,7 @@ class JobTest : public testing::Test {
     return path(name);
   }
 
-  Job small_job(const std::string& scene, const std::string& output) const {
-    Job j;
-    j.scene = scene;
-    j.output = output;
-    j.backend = "cpu";
-    j.width = 16;
-    j.height = 9;
-    j.spp = 2;
-    j.progress = false;
-    return j;
-  }
+  Job small_job(const std::string& scene, const std::string& output) const { return test::small_job(scene, output); }
 
   bool only_expected_files(std::initializer_list<std::string> names) const {
     size_t n = 0;
