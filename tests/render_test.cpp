@@ -6,10 +6,10 @@
 #include <numeric>
 
 #include "cuda/cuda_backend.hpp"
+#include "dispatch/renderer.hpp"
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
-#include "dispatch/renderer.hpp"
 #include "stages/wavefront.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"

@@ -18,9 +18,9 @@
 
 #include "app/job.hpp"
 #include "device/device.hpp"
-#include "errors/errors.hpp"
 #include "dispatch/renderer.hpp"
 #include "dispatch/split.hpp"
+#include "errors/errors.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -13,8 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/checkpoint.hpp"
-#include "app/job_files.hpp"
 #include "app/distributed.hpp"
+#include "app/job_files.hpp"
 #include "app/progress.hpp"
 #include "app/signals.hpp"
 #include "app/stats.hpp"

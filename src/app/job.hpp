@@ -7,9 +7,9 @@
 #include <string>
 
 #include "app/cluster.hpp"
+#include "dispatch/renderer.hpp"
 #include "errors/errors.hpp"
 #include "image/image_io.hpp"
-#include "dispatch/renderer.hpp"
 #include "render/settings.hpp"
 
 namespace wt::app {

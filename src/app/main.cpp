@@ -10,8 +10,8 @@
 
 #include "app/batch.hpp"
 #include "app/bench.hpp"
-#include "app/cluster.hpp"
 #include "app/cli.hpp"
+#include "app/cluster.hpp"
 #include "app/job.hpp"
 #include "app/job_files.hpp"
 #include "device/device.hpp"

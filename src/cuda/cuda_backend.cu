@@ -8,11 +8,11 @@
 #include <string>
 
 #include "cuda/buffer.hpp"
+#include "cuda/cuda_wavefront.hpp"
 #include "cuda/device_scene.hpp"
 #include "cuda/event.hpp"
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
-#include "cuda/cuda_wavefront.hpp"
 #include "render/passes.hpp"
 
 namespace wt::cuda {
