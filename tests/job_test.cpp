@@ -7,16 +7,19 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <stb/stb_image.h>
 
 #include "app/batch.hpp"
 #include "app/bench.hpp"
 #include "app/job.hpp"
 #include "errors/errors.hpp"
 #include "exr_support.hpp"
+#include "wavetrace/film.hpp"
 #include "job_support.hpp"
 #include "test_support.hpp"
 
@@ -76,9 +79,13 @@ TEST_F(JobTest, GoodJobWritesImageAndStats) {
   EXPECT_TRUE(only_expected_files({"s.json", "out.png", "stats.json"}));
 }
 
+// The PFM holds the render's linear means as they are, bottom row first, and nothing
+// after them; the PNG of the same job is those values through the sRGB curve.
 TEST_F(JobTest, PfmOutputHoldsLinearFloats) {
   Job j = small_job(write("s.json", kTinyScene), path("out.pfm"));
-  ASSERT_EQ(run_job(j).exit_code, 0);
+  const JobOutcome o = run_job(j);
+  ASSERT_EQ(o.exit_code, 0) << o.message;
+  ASSERT_EQ(o.result.rgb.size(), 16u * 9 * 3);
   std::ifstream f(path("out.pfm"), std::ios::binary);
   std::string magic;
   int w = 0, h = 0;
@@ -91,7 +98,30 @@ TEST_F(JobTest, PfmOutputHoldsLinearFloats) {
   f.get();
   std::vector<float> data(16 * 9 * 3);
   f.read(reinterpret_cast<char*>(data.data()), data.size() * sizeof(float));
-  EXPECT_TRUE(f.good());
+  ASSERT_TRUE(f.good());
+  EXPECT_EQ(f.peek(), std::char_traits<char>::eof()) << "bytes after the pixels";
+  size_t lit = 0;
+  for (int y = 0; y < 9; ++y) {
+    for (int x = 0; x < 16 * 3; ++x) {
+      const float in_file = data[static_cast<size_t>(8 - y) * 16 * 3 + x];
+      ASSERT_EQ(in_file, o.result.rgb[static_cast<size_t>(y) * 16 * 3 + x]) << "row " << y << " value " << x;
+      lit += in_file > 0.0f;
+    }
+  }
+  EXPECT_GT(lit, 16u * 9) << "an image with light in it";
+  // Linear: the PNG's bytes are the same values encoded.
+  j.output = path("out.png");
+  const JobOutcome png = run_job(j);
+  ASSERT_EQ(png.exit_code, 0) << png.message;
+  int pw = 0, ph = 0, channels = 0;
+  unsigned char* bytes = stbi_load(path("out.png").c_str(), &pw, &ph, &channels, 3);
+  ASSERT_NE(bytes, nullptr);
+  for (size_t i = 0; i < data.size(); ++i) {
+    const size_t y = i / (16 * 3), x = i % (16 * 3);
+    const float linear = data[(8 - y) * 16 * 3 + x];
+    EXPECT_EQ(bytes[i], static_cast<unsigned char>(std::lround(encode_srgb(linear) * 255.0f))) << i;
+  }
+  stbi_image_free(bytes);
 }
 
 void expect_bad_input(const JobOutcome& o, const std::string& must_contain) {

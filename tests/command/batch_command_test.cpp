@@ -148,6 +148,32 @@ const std::string kPrecious = "bytes that were here before the batch";
 
 // Two jobs writing one image: the second would overwrite the first's. Refused before
 // either runs, naming both.
+// One worker renders job A (an image texture and an environment), then B, then A
+// again: nothing of a job stays behind in the worker for the next (images, tables,
+// settings), so each image is bit for bit the one its job renders alone.
+TEST_F(BatchCommand, AWorkersJobsEachRenderTheImageTheyRenderAlone) {
+  const std::string textures = wt::test::repo_path("scenes/textures");
+  std::ofstream(path("a.json")) << R"({"camera": {"look_from": [0, 0.5, 4], "look_at": [0, 0, 0]},
+      "sky": {"type": "environment", "file": ")" << textures << R"(/sky_sun.hdr"},
+      "textures": [{"name": "t", "type": "image", "file": ")" << textures << R"(/planet.png"}],
+      "materials": [{"name": "m", "type": "lambertian", "texture": "t"}, {"name": "c", "type": "metal", "fuzz": 0.3}],
+      "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}, {"center": [1.6, 0, 0], "radius": 0.5, "material": "c"}]})";
+  std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "width": 40, "height": 24, "spp": 3},
+      "jobs": [{"scene": "a.json", "output": "a1.pfm"}, {"scene": "s.json", "output": "b1.pfm", "seed": 9},
+               {"scene": "a.json", "output": "a2.pfm"}]})";
+  ASSERT_EQ(batch("'" + path("jobs.json") + "'"), 0) << err_;
+  const std::string settings = " --backend=cpu --width=40 --height=24 --spp=3 --quiet ";
+  ASSERT_EQ(wavetrace("render --output='" + path("a.pfm") + "'" + settings + "'" + path("a.json") + "'"), 0) << err_;
+  ASSERT_EQ(wavetrace("render --output='" + path("b.pfm") + "' --seed=9" + settings + "'" + path("s.json") + "'"), 0)
+      << err_;
+  const std::string a = read(path("a.pfm")), b = read(path("b.pfm"));
+  ASSERT_GT(a.size(), 40u * 24 * 12);
+  EXPECT_NE(a, b);
+  EXPECT_TRUE(read(path("a1.pfm")) == a) << "job A first in the worker";
+  EXPECT_TRUE(read(path("b1.pfm")) == b) << "job B after A";
+  EXPECT_TRUE(read(path("a2.pfm")) == a) << "job A after B";
+}
+
 TEST_F(BatchCommand, TwoJobsWritingOneImageAreRefusedBeforeAnyRuns) {
   std::ofstream(path("jobs.json")) << R"({"defaults": {"backend": "cpu", "width": 32, "height": 16, "spp": 2},
     "jobs": [{"scene": "s.json", "output": "a.png"}, {"scene": "s.json", "output": "b.png"},
