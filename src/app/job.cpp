@@ -70,12 +70,6 @@ uint64_t count_nonfinite_pixels(const std::vector<float>& rgb) {
 
 namespace {
 
-bool is_png(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".png";
-}
-
 RenderParams resolve_params(const Scene& scene, const Job& job) {
   RenderParams p = default_params(scene);
   for (SettingId id : render_settings()) {
@@ -362,8 +356,7 @@ void warn_nonfinite(const Job& job, JobOutcome& out) {
   if (out.nonfinite_pixels == 0) return;
   std::fprintf(stderr, "wavetrace: %s: warning: %llu pixels are not finite (NaN or an infinity); %s\n",
                job.output.c_str(), static_cast<unsigned long long>(out.nonfinite_pixels),
-               is_png(job.output) ? "the PNG holds them as 0 (NaN) and 255 (infinity)"
-                                  : "the image holds them as they are");
+               nonfinite_pixels_written(job.output));
 }
 
 // The last phase: the image and the stats written, the checkpoint removed.

@@ -247,6 +247,11 @@ StagedFile stage_exr(const std::string& path, int w, int h, const std::vector<fl
 
 }  // namespace
 
+const char* nonfinite_pixels_written(const std::string& path) {
+  return format_of(path) == Format::Png ? "the PNG holds them as 0 (NaN) and 255 (infinity)"
+                                        : "the image holds them as they are";
+}
+
 void check_output_path(const std::string& path) {
   format_of(path);
   check_output_folder(path);

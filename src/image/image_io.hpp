@@ -15,6 +15,10 @@ enum class Encoding { Srgb, Gamma2 };
 // The pixel type of an OpenEXR image's channels.
 enum class ExrPixels { Half, Float };
 
+// How an image of this path's format holds a pixel that is not finite, in words: a
+// PNG clamps (NaN to 0, an infinity to 255), PFM and OpenEXR keep the value.
+const char* nonfinite_pixels_written(const std::string& path);
+
 // Throws OutputError naming the path when it cannot be written (unknown extension,
 // missing or unwritable folder). Run before rendering, so a bad path costs nothing.
 void check_output_path(const std::string& path);

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstring>
 
-
 namespace wt {
 
 namespace {
@@ -24,8 +23,9 @@ std::string size_text(uint64_t bytes) {
   return buf;
 }
 
-// What a file that is not regular is, in words; empty for a regular file.
-std::string not_regular(mode_t mode) {
+}  // namespace
+
+std::string not_a_regular_file(unsigned int mode) {
   if (S_ISREG(mode)) return "";
   if (S_ISDIR(mode)) return "it is a directory, not a file";
   if (S_ISFIFO(mode)) return "it is a FIFO (named pipe), not a regular file";
@@ -34,6 +34,8 @@ std::string not_regular(mode_t mode) {
   if (S_ISSOCK(mode)) return "it is a socket, not a regular file";
   return "it is not a regular file";
 }
+
+namespace {
 
 std::string too_large(uint64_t bytes, const InputKind& kind) {
   std::string held = size_text(bytes), limit = size_text(kind.max_bytes);
@@ -55,8 +57,6 @@ InputFileError read_refusal(const std::string& path, const InputKind& kind, cons
 
 }  // namespace
 
-std::string not_a_regular_file(unsigned int mode) { return not_regular(static_cast<mode_t>(mode)); }
-
 std::string read_input_file(const std::string& path, const InputKind& kind) {
   // O_NONBLOCK: opening a FIFO does not wait for a writer; the file is then checked
   // through its descriptor, so that what is read is what was checked.
@@ -66,7 +66,7 @@ std::string read_input_file(const std::string& path, const InputKind& kind) {
     // A socket cannot be opened (ENXIO): say what it is.
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-      throw read_refusal(path, kind, not_regular(st.st_mode));
+      throw read_refusal(path, kind, not_a_regular_file(st.st_mode));
     }
     throw open_failure(path, kind, err);
   }
@@ -76,7 +76,7 @@ std::string read_input_file(const std::string& path, const InputKind& kind) {
   } closer{fd};
   struct stat st {};
   if (::fstat(fd, &st) != 0) throw open_failure(path, kind, errno);
-  if (const std::string what = not_regular(st.st_mode); !what.empty()) throw read_refusal(path, kind, what);
+  if (const std::string what = not_a_regular_file(st.st_mode); !what.empty()) throw read_refusal(path, kind, what);
   const uint64_t size = static_cast<uint64_t>(st.st_size);
   if (size > kind.max_bytes) throw read_refusal(path, kind, too_large(size, kind));
   std::string bytes;

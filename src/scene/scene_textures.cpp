@@ -14,8 +14,8 @@
 #include <exception>
 #include <utility>
 
-#include "scene/input_file.hpp"
 #include "errors/errors.hpp"
+#include "scene/input_file.hpp"
 #include "scene/scene_reader.hpp"
 #include "wavetrace/film.hpp"
 
