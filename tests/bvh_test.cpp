@@ -21,14 +21,14 @@ struct SphereSet {
   std::vector<SphereGeom> spheres;
 };
 
-// sphere_material[i] = i, so after the builder's reordering each sphere still
+// sphere_materials[i] = i, so after the builder's reordering each sphere still
 // says where it was.
 Scene built(const std::vector<SphereGeom>& spheres) {
   Scene s;
   s.source = "bvh-test";
   s.spheres = spheres;
-  s.sphere_material.resize(spheres.size());
-  std::iota(s.sphere_material.begin(), s.sphere_material.end(), 0u);
+  s.sphere_materials.resize(spheres.size());
+  std::iota(s.sphere_materials.begin(), s.sphere_materials.end(), 0u);
   if (!spheres.empty()) s.placements.push_back({kSpheres, kIdentityTransform, kIdentityTransform, true, -1});
   build_bvh(s);
   return s;
@@ -152,7 +152,7 @@ TEST(Bvh, ClosestHitMatchesBruteForce) {
       ASSERT_EQ(got.missed(), expect.missed());
       if (expect.missed()) continue;
       ++hits;
-      ASSERT_EQ(scene.sphere_material[got.prim], static_cast<uint32_t>(expect.prim));
+      ASSERT_EQ(scene.sphere_materials[got.prim], static_cast<uint32_t>(expect.prim));
       ASSERT_EQ(got.t, expect.t);
     }
     EXPECT_GT(hits, 400) << "too few rays hit for the comparison to mean much";
@@ -175,7 +175,7 @@ TEST(Bvh, EverySphereIsInExactlyOneLeafOfAtMostFour) {
     // And the reordering is a permutation that moved each sphere with its material.
     std::vector<int> original(set.spheres.size(), 0);
     for (size_t i = 0; i < scene.spheres.size(); ++i) {
-      uint32_t from = scene.sphere_material[i];
+      uint32_t from = scene.sphere_materials[i];
       ASSERT_LT(from, set.spheres.size());
       ++original[from];
       EXPECT_EQ(scene.spheres[i].x, set.spheres[from].x);
@@ -248,7 +248,7 @@ TEST(Bvh, GroundSphereIsIsolatedBelowTheRoot) {
   int ground_leaf = -1;
   for (int child : {root.left_or_first, root.left_or_first + 1}) {
     const BvhNode& n = scene.nodes[child];
-    if (n.count == 1 && scene.sphere_material[n.left_or_first] == 0) ground_leaf = child;
+    if (n.count == 1 && scene.sphere_materials[n.left_or_first] == 0) ground_leaf = child;
   }
   EXPECT_GE(ground_leaf, 0) << "the radius-1000 sphere should be a child leaf of the root, alone";
 }

@@ -210,7 +210,7 @@ TEST_F(InstanceMaterials, MeshPlacedFiveTimesIsStoredOnce) {
   EXPECT_EQ(s.meshes.size(), 1u);
   EXPECT_EQ(s.meshes[0].triangle_count, count);
   EXPECT_EQ(s.triangles.size(), count);
-  EXPECT_EQ(s.triangle_material.size(), count);
+  EXPECT_EQ(s.triangle_materials.size(), count);
   EXPECT_EQ(s.instances.size(), 5u);
   EXPECT_EQ(s.instanced_triangles(), 5 * count);
   // Every placement is there to be hit, at its own place.

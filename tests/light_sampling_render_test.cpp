@@ -36,7 +36,7 @@ TEST(LightSamplingScene, TheEmitterTableHoldsTheCornellBoxLightByPower) {
   ASSERT_EQ(s.light_cdf.size(), 2u);
   EXPECT_NEAR(s.light_cdf[0], 0.5f, 1e-3f);
   EXPECT_EQ(s.light_cdf[1], 1.0f);
-  const Material& m = s.materials.at(s.triangle_material.at(s.lights[0].prim));
+  const Material& m = s.materials.at(s.triangle_materials.at(s.lights[0].prim));
   ASSERT_EQ(m.kind, MaterialKind::Emissive);
   EXPECT_NEAR(s.light_power, light_power_of(m.emission, 130.0f * 105.0f), 1e-3f * s.light_power);
   // Scenes without emitters have no table, and render as before.

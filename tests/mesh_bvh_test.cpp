@@ -265,7 +265,7 @@ TEST(MeshBvh, SpheresAndTransformedInstancesMatchBruteForce) {
   std::uniform_real_distribution<float> pos(-8.0f, 8.0f), radius(0.2f, 1.5f);
   for (int i = 0; i < 40; ++i) {
     s.spheres.push_back(SphereGeom{pos(rng), pos(rng), pos(rng), radius(rng)});
-    s.sphere_material.push_back(static_cast<uint32_t>(i));
+    s.sphere_materials.push_back(static_cast<uint32_t>(i));
   }
   const int32_t ball = test::add_mesh(s, test::icosphere(2), "ball");
   const int32_t ring = test::add_mesh(s, test::torus(1.0f, 0.3f, 24, 12), "ring");
@@ -334,7 +334,7 @@ TEST(MeshBvh, EveryTriangleIsInExactlyOneLeafOfItsMeshsTree) {
   for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "triangle " << i;
   // The reordering moved each triangle with its material (the test's original index).
   std::vector<int> original(s.triangles.size(), 0);
-  for (uint32_t from : s.triangle_material) {
+  for (uint32_t from : s.triangle_materials) {
     ASSERT_LT(from, original.size());
     ++original[from];
   }

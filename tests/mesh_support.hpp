@@ -178,9 +178,9 @@ inline int32_t add_mesh(Scene& s, const MeshData& mesh, const std::string& name)
       dst[1] = p.y;
       dst[2] = p.z;
     }
-    s.triangle_material.push_back(static_cast<uint32_t>(s.triangles.size()));
+    s.triangle_materials.push_back(static_cast<uint32_t>(s.triangles.size()));
     s.triangles.push_back(g);
-    s.triangle_shading.push_back(TriangleShading{{0, 0, 0}, 0u});
+    s.triangle_shadings.push_back(TriangleShading{{0, 0, 0}, 0u});
   }
   s.meshes.push_back(sm);
   return static_cast<int32_t>(s.meshes.size() - 1);

@@ -31,9 +31,9 @@ std::string spheres_scene(int n, int bad = -1) {
 void expect_loads(int n) {
   Scene scene = parse_scene(spheres_scene(n), "big.json");
   ASSERT_EQ(scene.spheres.size(), static_cast<size_t>(n));
-  ASSERT_EQ(scene.sphere_material.size(), static_cast<size_t>(n));
+  ASSERT_EQ(scene.sphere_materials.size(), static_cast<size_t>(n));
   size_t per_material[4] = {};
-  for (uint32_t m : scene.sphere_material) ++per_material[m];
+  for (uint32_t m : scene.sphere_materials) ++per_material[m];
   for (size_t count : per_material) EXPECT_EQ(count, static_cast<size_t>(n / 4));
   // Every sphere sits in exactly one leaf (the first node is the top level's one
   // leaf, over the spheres' tree).

@@ -177,7 +177,7 @@ TEST(SceneParser, ValidSceneParsesWithItsValues) {
 
   // The BVH reorders spheres; each must still carry its own material.
   ASSERT_EQ(s.spheres.size(), 5u);
-  ASSERT_EQ(s.sphere_material.size(), 5u);
+  ASSERT_EQ(s.sphere_materials.size(), 5u);
   ASSERT_FALSE(s.nodes.empty());
   const std::vector<std::pair<SphereGeom, std::string>> expected = {
       {{0, -1000, 0, 1000}, "ground"}, {{-2, 1, 0, 1}, "mirror"}, {{0, 1, 0, 1}, "glass"},
@@ -188,7 +188,7 @@ TEST(SceneParser, ValidSceneParsesWithItsValues) {
       const SphereGeom& g = s.spheres[i];
       if (g.x == geom.x && g.y == geom.y && g.z == geom.z && g.w == geom.w) {
         ++found;
-        EXPECT_EQ(s.material_names[s.sphere_material[i]], material);
+        EXPECT_EQ(s.material_names[s.sphere_materials[i]], material);
       }
     }
     EXPECT_EQ(found, 1) << material;
@@ -640,13 +640,19 @@ TEST(SceneParser, HostViewPointsIntoTheSceneWithTheRendersCamera) {
   // The render's size, not the scene file's defaults, shapes the camera.
   SceneView v = host_view(s, 160, 90, images);
   EXPECT_EQ(v.spheres, s.spheres.data());
-  EXPECT_EQ(v.sphere_materials, s.sphere_material.data());
+  EXPECT_EQ(v.sphere_materials, s.sphere_materials.data());
   EXPECT_EQ(v.nodes, s.nodes.data());
   EXPECT_EQ(v.instances, s.instances.data());
   EXPECT_EQ(v.materials, s.materials.data());
   EXPECT_EQ(v.textures, s.textures.data());
+  // Every array of the scene's list (scene_view.hpp), by name.
+#define WT_EXPECT_POINTS_INTO_THE_SCENE(T, array, at) EXPECT_EQ(v.array, s.array.data()) << #array;
+  WT_SCENE_ARRAYS(WT_EXPECT_POINTS_INTO_THE_SCENE)
+#undef WT_EXPECT_POINTS_INTO_THE_SCENE
   EXPECT_EQ(s.spheres.size(), 5u);
   EXPECT_EQ(v.node_count(), static_cast<int>(s.nodes.size()));
+  EXPECT_EQ(v.light_count(), static_cast<int>(s.lights.size()));
+  EXPECT_EQ(v.kinds, s.primitive_kinds());
   ASSERT_EQ(images.size(), 1u);
   EXPECT_EQ(v.images, images.data());
   EXPECT_EQ(images[0].object, 0u);
@@ -669,7 +675,7 @@ TEST(SceneParser, RepositoryScenesLoad) {
     Scene s = load_scene(test::repo_path(std::string("scenes/") + name));
     EXPECT_FALSE(s.spheres.empty());
     EXPECT_FALSE(s.nodes.empty());
-    EXPECT_EQ(s.sphere_material.size(), s.spheres.size());
+    EXPECT_EQ(s.sphere_materials.size(), s.spheres.size());
   }
 }
 

@@ -260,7 +260,7 @@ TYPED_TEST(Stages, IntersectFindsClosestHitsAddsSkyForMissesAndCountsRays) {
   EXPECT_EQ(instance[3], -1);
   for (uint32_t i = 0; i < 3; ++i) {
     EXPECT_EQ(entry_slot(entries[i]), i);
-    EXPECT_EQ(entry_key(entries[i]), scene.materials[scene.sphere_material[sphere[i]]].sort_key);
+    EXPECT_EQ(entry_key(entries[i]), scene.materials[scene.sphere_materials[sphere[i]]].sort_key);
   }
   for (uint32_t i = 3; i < 8; ++i) EXPECT_EQ(entry_key(entries[i]), kSortKeyMiss) << i;
   // The miss added throughput x sky (straight up: the zenith colour) to pixel 3, and nothing else was added.

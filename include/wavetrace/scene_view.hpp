@@ -21,54 +21,73 @@ struct RenderParams {
   int32_t nee = 1;         // 1: sample the emitters at every diffuse hit (next-event estimation); 0: not
 };
 
-// Scene access through plain pointers (global memory on the GPU, host memory on
-// the CPU). The constant-memory megakernel has an accessor of the same shape.
-// The accessor functions are the ones geometry/geometry.hpp names.
-struct SceneView {
-  const BvhNode* nodes;  // the top level over instances first, then each instance's
-  const Instance* instances;
-  const SphereGeom* spheres;
-  const uint32_t* sphere_materials;
-  const TriangleGeom* triangles;
-  const TriangleShading* triangle_shadings;
-  const uint32_t* triangle_materials;
-  const vec3* normals;
-  const vec2* uvs;
-  const Material* materials;
-  const Texture* textures;
-  const ImageView* images;
-  const LightRef* lights;   // every emitter, for next-event estimation
-  const float* light_cdf;   // light_cdf[i]: the probability of picking lights 0..i (the last is 1)
+}  // namespace wt
+
+// The scene's arrays, declared once. Each line names the element type, the array
+// (a std::vector in the host Scene, a pointer in SceneView, a device buffer in the
+// uploaded scene, an offset in the constant-memory pool) and the accessor through
+// which the tracing code reads one element. The host scene's members, the host and
+// device views, the upload, the constant-memory layout and its size check, and the
+// device byte count all follow from this list (docs/architecture.md, "Where a new
+// thing goes"). Two things of the scene are not plain arrays and are named where
+// they are used: its images (decoded texels on the host, texture objects on the
+// device) and the environment's sampling table (a struct with a view of its own,
+// kept in global memory by every kernel).
+#define WT_SCENE_ARRAYS(X)                                                                  \
+  X(BvhNode, nodes, node)                         /* the top level first, then each tree */ \
+  X(Instance, instances, instance)                /* in top-level order */                  \
+  X(SphereGeom, spheres, sphere)                  /* in BVH order */                        \
+  X(uint32_t, sphere_materials, sphere_material)  /* per sphere, in BVH order */            \
+  X(TriangleGeom, triangles, triangle)            /* every mesh's, one range a mesh */      \
+  X(TriangleShading, triangle_shadings, triangle_shading)                                   \
+  X(uint32_t, triangle_materials, triangle_material)                                        \
+  X(vec3, normals, normal) /* per vertex, of the meshes that have them */                   \
+  X(vec2, uvs, uv)                                                                          \
+  X(Material, materials, material)                                                          \
+  X(Texture, textures, texture)                                                             \
+  X(LightRef, lights, light)      /* every emitter, for next-event estimation */            \
+  X(float, light_cdf, light_cdf_at) /* [i]: the probability of picking lights 0..i */
+
+namespace wt {
+
+// What every view of a scene holds besides its arrays, and its accessors.
+struct SceneScalars {
+  int32_t node_total;
   int32_t light_total;
-  float light_power;        // the emitters' summed power (light_power_of), which picks them
+  float light_power;  // the emitters' summed power (light_power_of), which picks them
   // The sky as a light (lights.hpp's kSkyLight): the probability of picking it (0:
   // the sky is not sampled), and the environment's table (rows 0: none).
   float sky_pick;
   PiecewiseConstant2D environment;
-  int32_t node_total;
   uint32_t kinds;  // the primitive kinds present (geometry.hpp), for choosing a kernel
   Sky sky;
   Camera camera;
 
   WT_HD int node_count() const { return node_total; }
-  WT_HD BvhNode node(int i) const { return nodes[i]; }
-  WT_HD const Instance& instance(int i) const { return instances[i]; }
-  WT_HD SphereGeom sphere(int i) const { return spheres[i]; }
-  WT_HD uint32_t sphere_material(int i) const { return sphere_materials[i]; }
-  WT_HD TriangleGeom triangle(int i) const { return triangles[i]; }
-  WT_HD TriangleShading triangle_shading(int i) const { return triangle_shadings[i]; }
-  WT_HD uint32_t triangle_material(int i) const { return triangle_materials[i]; }
-  WT_HD vec3 normal(uint32_t i) const { return normals[i]; }
-  WT_HD vec2 uv(uint32_t i) const { return uvs[i]; }
-  WT_HD const Material& material(uint32_t i) const { return materials[i]; }
-  WT_HD const Texture* texture_array() const { return textures; }
-  WT_HD const ImageView* image_array() const { return images; }
   WT_HD int light_count() const { return light_total; }
-  WT_HD LightRef light(int i) const { return lights[i]; }
-  WT_HD float light_cdf_at(int i) const { return light_cdf[i]; }
   WT_HD float total_light_power() const { return light_power; }
   WT_HD float sky_light_pick() const { return sky_pick; }
   WT_HD const PiecewiseConstant2D& environment_table() const { return environment; }
 };
+
+#define WT_SCENE_VIEW_POINTER(T, array, at) const T* array;
+#define WT_SCENE_VIEW_AT(T, array, at) \
+  WT_HD const T& at(uint32_t i) const { return array[i]; }
+
+// Scene access through plain pointers (global memory on the GPU, host memory on
+// the CPU). The constant-memory megakernel has an accessor of the same shape.
+// The accessor functions are the ones geometry/geometry.hpp names.
+struct SceneView : SceneScalars {
+  WT_SCENE_ARRAYS(WT_SCENE_VIEW_POINTER)
+  const ImageView* images;
+
+  WT_SCENE_ARRAYS(WT_SCENE_VIEW_AT)
+  // The texture code takes the textures and the images whole.
+  WT_HD const Texture* texture_array() const { return textures; }
+  WT_HD const ImageView* image_array() const { return images; }
+};
+
+#undef WT_SCENE_VIEW_POINTER
+#undef WT_SCENE_VIEW_AT
 
 }  // namespace wt

@@ -7,19 +7,11 @@ constexpr const char* kStage = "scene upload";
 }
 
 DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
-  nodes_.upload(scene.nodes, kStage);
-  instances_.upload(scene.instances, kStage);
-  spheres_.upload(scene.spheres, kStage);
-  sphere_material_.upload(scene.sphere_material, kStage);
-  triangles_.upload(scene.triangles, kStage);
-  triangle_shading_.upload(scene.triangle_shading, kStage);
-  triangle_material_.upload(scene.triangle_material, kStage);
-  normals_.upload(scene.normals, kStage);
-  uvs_.upload(scene.uvs, kStage);
-  materials_.upload(scene.materials, kStage);
-  textures_.upload(scene.textures, kStage);
-  lights_.upload(scene.lights, kStage);
-  light_cdf_.upload(scene.light_cdf, kStage);
+#define WT_DEVICE_UPLOAD(T, array, at) \
+  array##_.upload(scene.array, kStage);    \
+  view_.array = array##_.get();
+  WT_SCENE_ARRAYS(WT_DEVICE_UPLOAD)
+#undef WT_DEVICE_UPLOAD
   environment_marginal_.upload(scene.environment.marginal_cdf, kStage);
   environment_conditional_.upload(scene.environment.conditional_cdf, kStage);
 
@@ -49,29 +41,10 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   }
   images_.upload(image_views_, kStage);
 
-  view_.nodes = nodes_.get();
-  view_.instances = instances_.get();
-  view_.spheres = spheres_.get();
-  view_.sphere_materials = sphere_material_.get();
-  view_.triangles = triangles_.get();
-  view_.triangle_shadings = triangle_shading_.get();
-  view_.triangle_materials = triangle_material_.get();
-  view_.normals = normals_.get();
-  view_.uvs = uvs_.get();
-  view_.materials = materials_.get();
-  view_.textures = textures_.get();
   view_.images = images_.get();
-  view_.lights = lights_.get();
-  view_.light_cdf = light_cdf_.get();
-  view_.light_total = static_cast<int32_t>(scene.lights.size());
-  view_.light_power = scene.light_power;
-  view_.sky_pick = scene.sky_pick;
-  view_.environment = PiecewiseConstant2D{environment_marginal_.get(), environment_conditional_.get(),
-                                          scene.environment.columns, scene.environment.rows};
-  view_.node_total = static_cast<int32_t>(scene.nodes.size());
-  view_.kinds = scene.primitive_kinds();
-  view_.sky = scene.sky;
-  view_.camera = Camera::make(scene.camera, width, height);
+  const PiecewiseConstant2D environment{environment_marginal_.get(), environment_conditional_.get(),
+                                        scene.environment.columns, scene.environment.rows};
+  static_cast<SceneScalars&>(view_) = scene_scalars(scene, width, height, environment);
 }
 
 DeviceScene::~DeviceScene() {

@@ -21,20 +21,10 @@ class DeviceScene {
   const std::vector<ImageView>& image_views() const { return image_views_; }
 
  private:
-  DeviceBuffer<BvhNode> nodes_;
-  DeviceBuffer<Instance> instances_;
-  DeviceBuffer<SphereGeom> spheres_;
-  DeviceBuffer<uint32_t> sphere_material_;
-  DeviceBuffer<TriangleGeom> triangles_;
-  DeviceBuffer<TriangleShading> triangle_shading_;
-  DeviceBuffer<uint32_t> triangle_material_;
-  DeviceBuffer<vec3> normals_;
-  DeviceBuffer<vec2> uvs_;
-  DeviceBuffer<Material> materials_;
-  DeviceBuffer<Texture> textures_;
+#define WT_DEVICE_BUFFER(T, array, at) DeviceBuffer<T> array##_;
+  WT_SCENE_ARRAYS(WT_DEVICE_BUFFER)
+#undef WT_DEVICE_BUFFER
   DeviceBuffer<ImageView> images_;
-  DeviceBuffer<LightRef> lights_;
-  DeviceBuffer<float> light_cdf_;
   DeviceBuffer<float> environment_marginal_, environment_conditional_;
   std::vector<cudaArray_t> arrays_;
   std::vector<cudaTextureObject_t> objects_;

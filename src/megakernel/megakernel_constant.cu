@@ -17,48 +17,34 @@ namespace {
 constexpr size_t kPoolBytes = 63 * 1024;
 __constant__ __align__(16) unsigned char c_pool[kPoolBytes];
 
-// Where each array starts in the pool.
+// Where each array starts in the pool: one offset per array of the scene's list
+// (scene_view.hpp), and the images' views.
+#define WT_CONSTANT_OFFSET(T, array, at) uint32_t array;
 struct ConstantLayout {
-  uint32_t nodes, instances, spheres, sphere_materials, triangles, triangle_shadings, triangle_materials, normals, uvs,
-      materials, textures, images, lights, light_cdf;
-  int32_t node_total, light_total;
-  float light_power, sky_pick;
-  // The environment's table stays in global memory, as the images do (it can be
-  // megabytes): the device view's pointers.
-  PiecewiseConstant2D environment;
+  WT_SCENE_ARRAYS(WT_CONSTANT_OFFSET)
+  uint32_t images;
 };
+#undef WT_CONSTANT_OFFSET
 
-struct ConstantScene {
+// The accessor over the pool. Its scalars (the environment's table among them, which
+// stays in global memory as the images do: it can be megabytes) are the device view's.
+// (The list gives every array an accessor; an unused one is no defect here.)
+#pragma nv_diag_suppress declared_but_not_referenced
+#define WT_CONSTANT_AT(T, array, at) \
+  __device__ const T& at(uint32_t i) const { return pool_array<T>(layout.array)[i]; }
+struct ConstantScene : SceneScalars {
   ConstantLayout layout;
-  Sky sky;
-  Camera camera;
 
   template <class T>
-  __device__ const T* array(uint32_t offset) const {
+  __device__ static const T* pool_array(uint32_t offset) {
     return reinterpret_cast<const T*>(c_pool + offset);
   }
-  __device__ int node_count() const { return layout.node_total; }
-  __device__ BvhNode node(int i) const { return array<BvhNode>(layout.nodes)[i]; }
-  __device__ const Instance& instance(int i) const { return array<Instance>(layout.instances)[i]; }
-  __device__ SphereGeom sphere(int i) const { return array<SphereGeom>(layout.spheres)[i]; }
-  __device__ uint32_t sphere_material(int i) const { return array<uint32_t>(layout.sphere_materials)[i]; }
-  __device__ TriangleGeom triangle(int i) const { return array<TriangleGeom>(layout.triangles)[i]; }
-  __device__ TriangleShading triangle_shading(int i) const {
-    return array<TriangleShading>(layout.triangle_shadings)[i];
-  }
-  __device__ uint32_t triangle_material(int i) const { return array<uint32_t>(layout.triangle_materials)[i]; }
-  __device__ vec3 normal(uint32_t i) const { return array<vec3>(layout.normals)[i]; }
-  __device__ vec2 uv(uint32_t i) const { return array<vec2>(layout.uvs)[i]; }
-  __device__ const Material& material(uint32_t i) const { return array<Material>(layout.materials)[i]; }
-  __device__ const Texture* texture_array() const { return array<Texture>(layout.textures); }
-  __device__ const ImageView* image_array() const { return array<ImageView>(layout.images); }
-  __device__ int light_count() const { return layout.light_total; }
-  __device__ LightRef light(int i) const { return array<LightRef>(layout.lights)[i]; }
-  __device__ float light_cdf_at(int i) const { return array<float>(layout.light_cdf)[i]; }
-  __device__ float total_light_power() const { return layout.light_power; }
-  __device__ float sky_light_pick() const { return layout.sky_pick; }
-  __device__ const PiecewiseConstant2D& environment_table() const { return layout.environment; }
+  WT_SCENE_ARRAYS(WT_CONSTANT_AT)
+  __device__ const Texture* texture_array() const { return pool_array<Texture>(layout.textures); }
+  __device__ const ImageView* image_array() const { return pool_array<ImageView>(layout.images); }
 };
+#undef WT_CONSTANT_AT
+#pragma nv_diag_default declared_but_not_referenced
 
 // The host copy of the accessor, filled by upload_constant_scene, and the uploaded
 // scene's primitive kinds: per host thread, as the current device is (a render split
@@ -90,32 +76,16 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
     return static_cast<uint32_t>(offset);
   };
   ConstantScene cs{};
-  cs.layout.nodes = place(scene.nodes);
-  cs.layout.instances = place(scene.instances);
-  cs.layout.spheres = place(scene.spheres);
-  cs.layout.sphere_materials = place(scene.sphere_material);
-  cs.layout.triangles = place(scene.triangles);
-  cs.layout.triangle_shadings = place(scene.triangle_shading);
-  cs.layout.triangle_materials = place(scene.triangle_material);
-  cs.layout.normals = place(scene.normals);
-  cs.layout.uvs = place(scene.uvs);
-  cs.layout.materials = place(scene.materials);
-  cs.layout.textures = place(scene.textures);
+#define WT_CONSTANT_PLACE(T, array, at) cs.layout.array = place(scene.array);
+  WT_SCENE_ARRAYS(WT_CONSTANT_PLACE)
+#undef WT_CONSTANT_PLACE
   cs.layout.images = place(images);
-  cs.layout.lights = place(scene.lights);
-  cs.layout.light_cdf = place(scene.light_cdf);
   if (pool.size() > kPoolBytes) {
     throw InputError(scene.source + ": the scene needs " + std::to_string(pool.size()) +
                      " bytes of constant memory; megakernel-constant holds at most " + std::to_string(kPoolBytes) +
                      " (use --kernel megakernel)");
   }
-  cs.layout.node_total = device_view.node_total;
-  cs.layout.light_total = device_view.light_total;
-  cs.layout.light_power = device_view.light_power;
-  cs.layout.sky_pick = device_view.sky_pick;
-  cs.layout.environment = device_view.environment;
-  cs.sky = device_view.sky;
-  cs.camera = device_view.camera;
+  static_cast<SceneScalars&>(cs) = device_view;
   WT_CUDA(cudaMemcpyToSymbol(c_pool, pool.data(), pool.size()), "constant upload");
   g_scene = cs;
   g_kinds = device_view.kinds;
@@ -124,7 +94,7 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
                                 unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
-  const uint32_t kinds_and_lights = g_kinds | (rp.nee != 0 && g_scene.layout.light_total > 0 ? kLightSampling : 0u);
+  const uint32_t kinds_and_lights = g_kinds | (rp.nee != 0 && g_scene.light_total > 0 ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {
     megakernel_constant<decltype(kinds)::value>
         <<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);

@@ -67,29 +67,21 @@ struct Scene {
   Sky sky{SkyKind::Gradient, vec3(1.0f), vec3(0.5f, 0.7f, 1.0f)};
   RenderDefaults render;
   std::vector<Image> images;
-  std::vector<Texture> textures;
-  std::vector<Material> materials;
-  std::vector<std::string> material_names;
-  std::vector<SphereGeom> spheres;          // in BVH order once built
-  std::vector<uint32_t> sphere_material;    // per sphere, in BVH order
-  // Every mesh's triangles, one contiguous range per mesh, in BVH order once built.
-  std::vector<TriangleGeom> triangles;
-  std::vector<TriangleShading> triangle_shading;
-  std::vector<uint32_t> triangle_material;
-  std::vector<vec3> normals;  // per vertex, of the meshes that have them
-  std::vector<vec2> uvs;
+  std::vector<std::string> material_names;  // per material
   std::vector<SceneMesh> meshes;
   std::vector<Placement> placements;
-  // Built from the above by build_bvh: the instances in top-level order and the
-  // node array (the top level first, then the spheres' and each mesh's tree).
-  std::vector<Instance> instances;
-  std::vector<BvhNode> nodes;
-  // The emitters (every emissive primitive of every instance, with the material
-  // it shades with) and the table that picks them by power (lights.hpp).
-  // The sky is one of them (kSkyLight) where it is sampled: sky_pick is then the
-  // probability of picking it, and `environment` its table where it has one.
-  std::vector<LightRef> lights;
-  std::vector<float> light_cdf;
+  // The arrays that the renderer reads (scene_view.hpp's list; the comments there
+  // say what each holds). The scene file fills the materials, textures, spheres and
+  // the meshes' triangle arrays, one contiguous range per mesh; build_bvh puts the
+  // primitives in BVH order and fills the nodes (the top level first, then the
+  // spheres' and each mesh's tree) and the instances in top-level order. The lights
+  // are every emissive primitive of every instance, with the material it shades
+  // with, and light_cdf the table that picks them by power (lights.hpp).
+#define WT_SCENE_VECTOR(T, array, at) std::vector<T> array;
+  WT_SCENE_ARRAYS(WT_SCENE_VECTOR)
+#undef WT_SCENE_VECTOR
+  // The sky is one of the lights (kSkyLight) where it is sampled: sky_pick is then
+  // the probability of picking it, and `environment` its table where it has one.
   float light_power = 0.0f;
   float sky_pick = 0.0f;
   EnvironmentDistribution environment;
@@ -138,6 +130,10 @@ Scene parse_scene(const std::string& json_text, const std::string& source);
 // Builds the bottom-level BVHs (over the spheres, and over each mesh's triangles,
 // reordering their arrays), the instances and the top-level BVH over them.
 void build_bvh(Scene& scene);
+
+// What every view of the scene holds besides its arrays, for a render of
+// width x height, with the environment's table as the view's memory holds it.
+SceneScalars scene_scalars(const Scene& scene, int width, int height, const PiecewiseConstant2D& environment);
 
 // A host view of the scene (pointers into `scene`) for a render of width x height,
 // for the CPU backend.

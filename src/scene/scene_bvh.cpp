@@ -99,7 +99,7 @@ void build_bvh(Scene& scene) {
       throw InputError(scene.source + ": /spheres: " + e.what());
     }
     permute_range(scene.spheres, 0, tree.order);
-    permute_range(scene.sphere_material, 0, tree.order);
+    permute_range(scene.sphere_materials, 0, tree.order);
     scene.sphere_bvh = bvh_stats(tree.nodes, blas_options);
     sphere_tree = std::move(tree.nodes);
   }
@@ -117,8 +117,8 @@ void build_bvh(Scene& scene) {
       throw InputError(mesh.file + ": " + e.what());
     }
     permute_range(scene.triangles, mesh.first_triangle, tree.order);
-    permute_range(scene.triangle_shading, mesh.first_triangle, tree.order);
-    permute_range(scene.triangle_material, mesh.first_triangle, tree.order);
+    permute_range(scene.triangle_shadings, mesh.first_triangle, tree.order);
+    permute_range(scene.triangle_materials, mesh.first_triangle, tree.order);
     mesh.bvh = bvh_stats(tree.nodes, blas_options);
     mesh_trees[m] = std::move(tree.nodes);
   }
@@ -235,7 +235,7 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
     if (in.kind == PrimitiveKind::Sphere) {
       for (size_t p = 0; p < scene.spheres.size(); ++p) {
         const SphereGeom& sg = scene.spheres[p];
-        add(index, static_cast<uint32_t>(p), in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.sphere_material[p],
+        add(index, static_cast<uint32_t>(p), in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.sphere_materials[p],
             EmitterShape::of_sphere(vec3(sg.x, sg.y, sg.z), sg.w));
       }
       continue;
@@ -244,7 +244,7 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
     for (uint32_t t = mesh.first_triangle; t < mesh.first_triangle + mesh.triangle_count; ++t) {
       vec3 a, b, c;
       world_triangle(scene.triangles[t], in, a, b, c);
-      add(index, t, in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.triangle_material[t],
+      add(index, t, in.material >= 0 ? static_cast<uint32_t>(in.material) : scene.triangle_materials[t],
           EmitterShape::of_triangle(a, b, c));
     }
   }
@@ -286,11 +286,10 @@ size_t bytes_of(const std::vector<T>& v) {
 }  // namespace
 
 size_t Scene::device_bytes() const {
-  size_t total = bytes_of(nodes) + bytes_of(instances) + bytes_of(lights) + bytes_of(light_cdf) +
-                 bytes_of(environment.marginal_cdf) + bytes_of(environment.conditional_cdf) + bytes_of(spheres) +
-                 bytes_of(sphere_material) +
-                 bytes_of(triangles) + bytes_of(triangle_shading) + bytes_of(triangle_material) + bytes_of(normals) +
-                 bytes_of(uvs) + bytes_of(materials) + bytes_of(textures);
+#define WT_ARRAY_BYTES(T, array, at) +bytes_of(array)
+  size_t total = 0 WT_SCENE_ARRAYS(WT_ARRAY_BYTES);
+#undef WT_ARRAY_BYTES
+  total += bytes_of(environment.marginal_cdf) + bytes_of(environment.conditional_cdf);
   for (const Image& im : images) total += bytes_of(im.texels);
   return total;
 }

@@ -12,7 +12,7 @@ void SceneReader::read_sphere(const json& j, const JsonPath& path) {
   }
   const int32_t m = material_named(required(j, path, "material"), path / "material");
   scene_.spheres.push_back(SphereGeom{c.x, c.y, c.z, r});
-  scene_.sphere_material.push_back(static_cast<uint32_t>(m));
+  scene_.sphere_materials.push_back(static_cast<uint32_t>(m));
 }
 
 }  // namespace wt

@@ -29,7 +29,7 @@ void SceneReader::read(const json& root) {
     const JsonPath path = top / "spheres";
     const json& spheres = array(root["spheres"], path);
     scene_.spheres.reserve(spheres.size());
-    scene_.sphere_material.reserve(spheres.size());
+    scene_.sphere_materials.reserve(spheres.size());
     for (size_t i = 0; i < spheres.size(); ++i) read_sphere(spheres[i], path / i);
     if (!spheres.empty()) scene_.placements.push_back(Placement{kSpheres, kIdentityTransform, kIdentityTransform, true, -1});
   }
@@ -154,32 +154,28 @@ int Scene::sort_key_bits() const {
   return std::max(bits, 1);
 }
 
+SceneScalars scene_scalars(const Scene& scene, int width, int height, const PiecewiseConstant2D& environment) {
+  SceneScalars v{};
+  v.node_total = static_cast<int32_t>(scene.nodes.size());
+  v.light_total = static_cast<int32_t>(scene.lights.size());
+  v.light_power = scene.light_power;
+  v.sky_pick = scene.sky_pick;
+  v.environment = environment;
+  v.kinds = scene.primitive_kinds();
+  v.sky = scene.sky;
+  v.camera = Camera::make(scene.camera, width, height);
+  return v;
+}
+
 SceneView host_view(const Scene& scene, int width, int height, std::vector<ImageView>& image_views) {
   image_views.clear();
   for (const Image& im : scene.images) image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height});
   SceneView v{};
-  v.nodes = scene.nodes.data();
-  v.instances = scene.instances.data();
-  v.spheres = scene.spheres.data();
-  v.sphere_materials = scene.sphere_material.data();
-  v.triangles = scene.triangles.data();
-  v.triangle_shadings = scene.triangle_shading.data();
-  v.triangle_materials = scene.triangle_material.data();
-  v.normals = scene.normals.data();
-  v.uvs = scene.uvs.data();
-  v.materials = scene.materials.data();
-  v.textures = scene.textures.data();
+  static_cast<SceneScalars&>(v) = scene_scalars(scene, width, height, scene.environment.view());
+#define WT_HOST_POINTER(T, array, at) v.array = scene.array.data();
+  WT_SCENE_ARRAYS(WT_HOST_POINTER)
+#undef WT_HOST_POINTER
   v.images = image_views.data();
-  v.lights = scene.lights.data();
-  v.light_cdf = scene.light_cdf.data();
-  v.light_total = static_cast<int32_t>(scene.lights.size());
-  v.light_power = scene.light_power;
-  v.sky_pick = scene.sky_pick;
-  v.environment = scene.environment.view();
-  v.node_total = static_cast<int32_t>(scene.nodes.size());
-  v.kinds = scene.primitive_kinds();
-  v.sky = scene.sky;
-  v.camera = Camera::make(scene.camera, width, height);
   return v;
 }
 

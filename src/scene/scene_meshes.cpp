@@ -113,8 +113,8 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   }
   const uint32_t flags = (normals ? kTriangleHasNormals : 0u) | (uvs ? kTriangleHasUvs : 0u);
   scene_.triangles.reserve(total);
-  scene_.triangle_shading.reserve(total);
-  scene_.triangle_material.reserve(total);
+  scene_.triangle_shadings.reserve(total);
+  scene_.triangle_materials.reserve(total);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& v = mesh.triangles[t];
     TriangleGeom g{};
@@ -129,8 +129,8 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
     TriangleShading sh{};
     for (int c = 0; c < 3; ++c) sh.vertex[c] = flags ? base + v[c] : 0u;
     sh.flags = flags;
-    scene_.triangle_shading.push_back(sh);
-    scene_.triangle_material.push_back(material_override >= 0 ? static_cast<uint32_t>(material_override)
+    scene_.triangle_shadings.push_back(sh);
+    scene_.triangle_materials.push_back(material_override >= 0 ? static_cast<uint32_t>(material_override)
                                                               : material_of[mesh.triangle_material[t]]);
   }
   scene_.meshes.push_back(std::move(sm));
