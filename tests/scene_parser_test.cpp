@@ -646,7 +646,7 @@ TEST(SceneParser, HostViewPointsIntoTheSceneWithTheRendersCamera) {
   EXPECT_EQ(v.materials, s.materials.data());
   EXPECT_EQ(v.textures, s.textures.data());
   // Every array of the scene's list (scene_view.hpp), by name.
-#define WT_EXPECT_POINTS_INTO_THE_SCENE(T, array, at) EXPECT_EQ(v.array, s.array.data()) << #array;
+#define WT_EXPECT_POINTS_INTO_THE_SCENE(T, array, at, Return, Index) EXPECT_EQ(v.array, s.array.data()) << #array;
   WT_SCENE_ARRAYS(WT_EXPECT_POINTS_INTO_THE_SCENE)
 #undef WT_EXPECT_POINTS_INTO_THE_SCENE
   EXPECT_EQ(s.spheres.size(), 5u);

@@ -7,7 +7,7 @@ constexpr const char* kStage = "scene upload";
 }
 
 DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
-#define WT_DEVICE_UPLOAD(T, array, at) \
+#define WT_DEVICE_UPLOAD(T, array, at, Return, Index) \
   array##_.upload(scene.array, kStage);    \
   view_.array = array##_.get();
   WT_SCENE_ARRAYS(WT_DEVICE_UPLOAD)

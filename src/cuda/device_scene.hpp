@@ -21,7 +21,7 @@ class DeviceScene {
   const std::vector<ImageView>& image_views() const { return image_views_; }
 
  private:
-#define WT_DEVICE_BUFFER(T, array, at) DeviceBuffer<T> array##_;
+#define WT_DEVICE_BUFFER(T, array, at, Return, Index) DeviceBuffer<T> array##_;
   WT_SCENE_ARRAYS(WT_DEVICE_BUFFER)
 #undef WT_DEVICE_BUFFER
   DeviceBuffer<ImageView> images_;

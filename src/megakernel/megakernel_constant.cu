@@ -19,7 +19,7 @@ __constant__ __align__(16) unsigned char c_pool[kPoolBytes];
 
 // Where each array starts in the pool: one offset per array of the scene's list
 // (scene_view.hpp), and the images' views.
-#define WT_CONSTANT_OFFSET(T, array, at) uint32_t array;
+#define WT_CONSTANT_OFFSET(T, array, at, Return, Index) uint32_t array;
 struct ConstantLayout {
   WT_SCENE_ARRAYS(WT_CONSTANT_OFFSET)
   uint32_t images;
@@ -30,8 +30,8 @@ struct ConstantLayout {
 // stays in global memory as the images do: it can be megabytes) are the device view's.
 // (The list gives every array an accessor; an unused one is no defect here.)
 #pragma nv_diag_suppress declared_but_not_referenced
-#define WT_CONSTANT_AT(T, array, at) \
-  __device__ const T& at(uint32_t i) const { return pool_array<T>(layout.array)[i]; }
+#define WT_CONSTANT_AT(T, array, at, Return, Index) \
+  __device__ Return at(Index i) const { return pool_array<T>(layout.array)[i]; }
 struct ConstantScene : SceneScalars {
   ConstantLayout layout;
 
@@ -76,7 +76,7 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
     return static_cast<uint32_t>(offset);
   };
   ConstantScene cs{};
-#define WT_CONSTANT_PLACE(T, array, at) cs.layout.array = place(scene.array);
+#define WT_CONSTANT_PLACE(T, array, at, Return, Index) cs.layout.array = place(scene.array);
   WT_SCENE_ARRAYS(WT_CONSTANT_PLACE)
 #undef WT_CONSTANT_PLACE
   cs.layout.images = place(images);

@@ -77,7 +77,7 @@ struct Scene {
   // spheres' and each mesh's tree) and the instances in top-level order. The lights
   // are every emissive primitive of every instance, with the material it shades
   // with, and light_cdf the table that picks them by power (lights.hpp).
-#define WT_SCENE_VECTOR(T, array, at) std::vector<T> array;
+#define WT_SCENE_VECTOR(T, array, at, Return, Index) std::vector<T> array;
   WT_SCENE_ARRAYS(WT_SCENE_VECTOR)
 #undef WT_SCENE_VECTOR
   // The sky is one of the lights (kSkyLight) where it is sampled: sky_pick is then

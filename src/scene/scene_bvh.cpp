@@ -286,7 +286,7 @@ size_t bytes_of(const std::vector<T>& v) {
 }  // namespace
 
 size_t Scene::device_bytes() const {
-#define WT_ARRAY_BYTES(T, array, at) +bytes_of(array)
+#define WT_ARRAY_BYTES(T, array, at, Return, Index) +bytes_of(array)
   size_t total = 0 WT_SCENE_ARRAYS(WT_ARRAY_BYTES);
 #undef WT_ARRAY_BYTES
   total += bytes_of(environment.marginal_cdf) + bytes_of(environment.conditional_cdf);

@@ -172,7 +172,7 @@ SceneView host_view(const Scene& scene, int width, int height, std::vector<Image
   for (const Image& im : scene.images) image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height});
   SceneView v{};
   static_cast<SceneScalars&>(v) = scene_scalars(scene, width, height, scene.environment.view());
-#define WT_HOST_POINTER(T, array, at) v.array = scene.array.data();
+#define WT_HOST_POINTER(T, array, at, Return, Index) v.array = scene.array.data();
   WT_SCENE_ARRAYS(WT_HOST_POINTER)
 #undef WT_HOST_POINTER
   v.images = image_views.data();
