@@ -631,9 +631,10 @@ def read_gltf(path, mesh_name, notes):
                         n2[i:i + 3] = array.array("f", [c / ln for c in w])
                     nrm = n2
             if every_uv:
-                # glTF's v = 0 is the image's top row, where Mitsuba's bitmap has
-                # v = 0 as well (wavetrace reads 1 - v into OBJ's convention and
-                # flips back when it samples): written as it is.
+                # glTF's v = 0 is the image's top row, where Mitsuba's bitmap and
+                # wavetrace's mesh UVs have v = 0 as well: written as it is. (OBJ
+                # files go to Mitsuba as they are; its reader and wavetrace's both
+                # read OBJ's v as 1 - v.)
                 uv = _gltf_accessor(doc, buffers, prim["attributes"]["TEXCOORD_0"])
             write_ply(out, pos, nrm, uv, ind)
         parts.append(MeshPart("ply", out, material, every_normal, _bounds(pos), area_of))

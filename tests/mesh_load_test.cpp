@@ -105,7 +105,8 @@ TEST_F(MeshLoad, ObjGivesPositionsNormalsUvsTrianglesAndMaterials) {
   TriangleMesh m = load_mesh(path);
   EXPECT_EQ(m.source, path);
   // One vertex per distinct (position, normal, uv) corner: the four of the quad, in
-  // the order the library's triangulation reaches them. Here uv = position's (x, y).
+  // the order the library's triangulation reaches them. Here the file's uv is the
+  // position's (x, y), read with v flipped (OBJ's v = 0 is the image's bottom row).
   ASSERT_EQ(m.positions.size(), 4u);
   ASSERT_EQ(m.normals.size(), 4u);
   ASSERT_EQ(m.uvs.size(), 4u);
@@ -113,7 +114,7 @@ TEST_F(MeshLoad, ObjGivesPositionsNormalsUvsTrianglesAndMaterials) {
     expect_vec(m.normals[i], vec3(0, 0, 1));  // normalized
     EXPECT_EQ(m.positions[i].z, 0.0f);
     EXPECT_EQ(m.uvs[i].x, m.positions[i].x);
-    EXPECT_EQ(m.uvs[i].y, m.positions[i].y);
+    EXPECT_EQ(m.uvs[i].y, 1.0f - m.positions[i].y);
   }
   ASSERT_EQ(m.triangles.size(), 6u);
   auto corners = [&](size_t t) {
@@ -302,7 +303,7 @@ void expect_quad(const TriangleMesh& m) {
   ASSERT_EQ(m.normals.size(), 4u);
   ASSERT_EQ(m.uvs.size(), 4u);
   const vec3 corners[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
-  const float v[4] = {1, 1, 0, 0.75f};  // glTF's v flipped: 1 - v
+  const float v[4] = {0, 0, 1, 0.25f};  // glTF's v as the file has it
   for (size_t i = 0; i < 4; ++i) {
     expect_vec(m.positions[i], corners[i] + vec3(10, 20, 30));  // the node's translation
     expect_vec(m.normals[i], vec3(0, 0, 1));

@@ -402,7 +402,10 @@ void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) 
         auto [it, added] = vertices.emplace(key, 0);
         if (added) {
           vec3 n = key[1] >= 0 ? glm::make_vec3(&attrib.normals[3 * static_cast<size_t>(key[1])]) : vec3(0.0f);
+          // OBJ puts v = 0 at the image's bottom row; a mesh's UVs, as the images are
+          // held (row 0 at the top) and as glTF has them, at its top.
           vec2 uv = key[2] >= 0 ? glm::make_vec2(&attrib.texcoords[2 * static_cast<size_t>(key[2])]) : vec2(0.0f);
+          uv.y = 1.0f - uv.y;
           it->second = builder.add_vertex(position(key[0]), key[1] >= 0 ? &n : nullptr, key[2] >= 0 ? &uv : nullptr);
         }
         corner[k] = it->second;
@@ -707,8 +710,8 @@ class GltfReader {
         world_pos[i] = vec3(p4);
         vec3 n;
         if (nrm.data) n = vec3(normal_matrix * glm::dvec3(component(nrm, i, 0), component(nrm, i, 1), component(nrm, i, 2)));
-        // glTF puts v = 0 at the image's top, OBJ (and TriangleMesh) at its bottom.
-        vec2 tc = uv.data ? vec2(component(uv, i, 0), 1.0f - component(uv, i, 1)) : vec2(0.0f);
+        // glTF puts v = 0 at the image's top row, as a mesh's UVs do.
+        vec2 tc = uv.data ? vec2(component(uv, i, 0), component(uv, i, 1)) : vec2(0.0f);
         builder_.add_vertex(world_pos[i], nrm.data ? &n : nullptr, uv.data ? &tc : nullptr);
       }
 

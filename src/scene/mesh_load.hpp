@@ -25,7 +25,7 @@ struct TriangleMesh {
   std::string source;  // the mesh file
   std::vector<vec3> positions;
   std::vector<vec3> normals;  // shading normals, one per vertex; empty where the file lacks any
-  std::vector<vec2> uvs;      // one per vertex; empty where the file lacks any
+  std::vector<vec2> uvs;      // one per vertex, v = 0 the image's top row; empty where the file lacks any
   std::vector<std::array<uint32_t, 3>> triangles;  // vertex indices
   std::vector<uint32_t> triangle_material;         // per triangle, an index into materials
   std::vector<MeshMaterial> materials;
