@@ -13,6 +13,7 @@
 // density the sampler draws from, and no cell has density 0.
 #pragma once
 
+#include "wavetrace/mutant.hpp"
 #include "wavetrace/sampling.hpp"
 #include "wavetrace/sky.hpp"
 
@@ -149,12 +150,13 @@ WT_HD WT_INLINE EnvironmentSample sample_environment(const Sky& sky, const Piece
   if (sky.mapping != EnvironmentMapping::LatLong || table.rows == 0)
     return EnvironmentSample{vec3(0.0f, 1.0f, 0.0f), 0.0f, vec2(0.0f), 0, 0};
   const Sample2D s = table.sample(u_row, u_column);
+  const float v = WT_MUTANT(EnvironmentRowShifted) ? fminf(s.v + 1.0f / table.rows, 1.0f) : s.v;
   const float phi = 2.0f * kPi * s.u;
-  const float sin_theta = sin_pi(s.v);
-  const float cos_theta = cosf(kPi * s.v);
+  const float sin_theta = sin_pi(v);
+  const float cos_theta = cosf(kPi * v);
   const vec3 e(sin_theta * sinf(phi), cos_theta, -sin_theta * cosf(phi));
   const float pdf = sin_theta > 0.0f ? s.pdf / (2.0f * kPi * kPi * sin_theta) : 0.0f;
-  return EnvironmentSample{environment_to_world(sky, e), pdf, vec2(s.u, s.v), s.column, s.row};
+  return EnvironmentSample{environment_to_world(sky, e), pdf, vec2(s.u, v), s.column, s.row};
 }
 
 // The density per solid angle with which sample_environment draws `unit_dir`

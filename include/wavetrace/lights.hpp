@@ -5,6 +5,7 @@
 #pragma once
 
 #include "wavetrace/config.hpp"
+#include "wavetrace/mutant.hpp"
 
 namespace wt {
 
@@ -134,10 +135,13 @@ struct EmitterShape {
   // The density per solid angle at p of sample(p, ...) drawing `dir` (unit), which
   // meets the shape at distance `dist`.
   WT_HD float pdf(const vec3& p, const vec3& dir, float dist) const {
-    return sphere ? sphere_light_pdf(a, radius, p) : triangle_light_pdf(a, b, c, dir, dist);
+    const float density = sphere ? sphere_light_pdf(a, radius, p) : triangle_light_pdf(a, b, c, dir, dist);
+    return WT_MUTANT(LightPdfScaled) ? 1.05f * density : density;
   }
   WT_HD LightSample sample(const vec3& p, float u1, float u2) const {
-    return sphere ? sample_sphere_light(a, radius, p, u1, u2) : sample_triangle_light(a, b, c, p, u1, u2);
+    LightSample s = sphere ? sample_sphere_light(a, radius, p, u1, u2) : sample_triangle_light(a, b, c, p, u1, u2);
+    if (WT_MUTANT(LightPdfScaled)) s.pdf *= 1.05f;
+    return s;
   }
 };
 
@@ -146,7 +150,7 @@ struct EmitterShape {
 // weights of a direction sum to 1.
 WT_HD WT_INLINE float power_heuristic(float f, float g) {
   const float f2 = f * f, g2 = g * g;
-  return f2 + g2 > 0.0f ? f2 / (f2 + g2) : 0.0f;
+  return f2 + g2 > 0.0f ? (WT_MUTANT(MisWeightsSwapped) ? g2 : f2) / (f2 + g2) : 0.0f;
 }
 
 }  // namespace wt

@@ -2,6 +2,7 @@
 // transport that every backend and kernel runs.
 #pragma once
 
+#include "wavetrace/mutant.hpp"
 #include "wavetrace/scene_lights.hpp"
 #include "wavetrace/scene_view.hpp"
 
@@ -31,6 +32,12 @@ WT_HD WT_INLINE Ray primary_ray(const Scene& scene, const RenderParams& rp, uint
 // Whether anything blocks `ray` before tmax (a shadow ray: the first hit ends it).
 template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE bool occluded(const Scene& scene, const Ray& ray, float tmax) {
+  if (WT_MUTANT(ShadowIgnoresFirstHit)) {
+    const Hit first = intersect_closest<Kinds, false>(scene, ray, tmax);
+    if (first.missed()) return false;
+    const float past = first.t * (1.0f + 1e-4f) + 1e-4f;
+    return past < tmax && !intersect_closest<Kinds, true>(scene, Ray{ray.at(past), ray.dir}, tmax - past).missed();
+  }
   return !intersect_closest<Kinds, true>(scene, ray, tmax).missed();
 }
 
@@ -73,8 +80,9 @@ struct ScatterDensity {
 
   WT_HD float operator()(const vec3& dir) const {
     const float cos_n = glm::dot(dir, facing_n);
-    if (fuzz > 0.0f) return cos_n > 0.0f ? metal_fuzz_pdf(reflected, fuzz, dir) : 0.0f;
-    return diffuse * fmaxf(cos_n, 0.0f) * (1.0f / kPi);
+    const float density = fuzz > 0.0f ? (cos_n > 0.0f ? metal_fuzz_pdf(reflected, fuzz, dir) : 0.0f)
+                                      : diffuse * fmaxf(cos_n, 0.0f) * (1.0f / kPi);
+    return WT_MUTANT(BsdfPdfScaled) ? 1.05f * density : density;
   }
   WT_HD bool samples_lights() const { return diffuse > 0.0f || fuzz > 0.0f; }
 };
@@ -93,7 +101,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, c
   float pick;
   const LightRef light = scene.light(pick_light(scene, rng.uniform(kDimLightPick), pick));
   if (!(pick > 0.0f)) return out;
-  const float u1 = rng.uniform(kDimLightA), u2 = rng.uniform(kDimLightB);
+  const float u1 = rng.uniform(WT_MUTANT(DimensionReused) ? kDimLightPick : kDimLightA), u2 = rng.uniform(kDimLightB);
   const vec3 outward = sp.front ? sp.ng : -sp.ng;
   vec3 emitted;
   float drawn_pdf;  // the density the direction was drawn with, times the picking probability
@@ -128,7 +136,8 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, c
   const float bsdf_pdf = bsdf(out.ray.dir);
   if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
   // BSDF x cos = albedo x bsdf_pdf (ScatterDensity).
-  out.contribution = throughput * albedo * emitted * (bsdf_pdf * power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
+  const float f_cos = WT_MUTANT(MissingCosine) ? bsdf_pdf / fmaxf(glm::dot(out.ray.dir, bsdf.facing_n), 1e-3f) : bsdf_pdf;
+  out.contribution = throughput * albedo * emitted * (f_cos * power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
 }
@@ -187,7 +196,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
     // Survive with probability p and divide by it: the expectation is unchanged.
     float p = fminf(fmaxf(throughput.x, fmaxf(throughput.y, throughput.z)), 0.95f);
     if (!(rng.uniform(kDimRoulette) < p)) return false;
-    throughput *= 1.0f / p;
+    if (!WT_MUTANT(RouletteWithoutOneOverQ)) throughput *= 1.0f / p;
   }
   ray = next;
   return true;

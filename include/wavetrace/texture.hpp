@@ -4,6 +4,7 @@
 #pragma once
 
 #include "wavetrace/geometry/surface.hpp"
+#include "wavetrace/mutant.hpp"
 #include "wavetrace/rng.hpp"
 
 namespace wt {
@@ -116,6 +117,7 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
     }
     case TextureKind::Image: {
       vec2 uv = sp.has_uv ? sp.uv : sphere_uv(sp.n);
+      if (WT_MUTANT(TextureVFlipped)) uv.y = 1.0f - uv.y;
       return sample_image(images[t.image], uv.x, uv.y);
     }
   }
