@@ -733,14 +733,14 @@ def save_manifest(m):
                   "and roulette_depth, and compares per tile x tile against the image. Seed %d made the "
                   "wavetrace references: no test may use it. In agreement, worst_tile is [column, row, "
                   "channel] of 8 x 8 tiles, counted from the top left." % REFERENCE_SEED)
-    fresh = []
-    for old in m["references"]:
+    for old in m["references"]:   # in place: callers hold these dicts
         e = entry(old["name"])
         e.update({k: old[k] for k in MEASURED if k in old})
         if "reference_spp" in e:
             e["reference_factor"] = round(e["reference_spp"] / (SEEDS * e["test"]["spp_per_seed"]), 1)
-        fresh.append(e)
-    m["references"] = sorted(fresh, key=lambda r: list(scenes()).index(r["name"]))
+        old.clear()
+        old.update(e)
+    m["references"].sort(key=lambda r: list(scenes()).index(r["name"]))
     with open(manifest_path() + ".tmp", "w") as f:
         json.dump(m, f, indent=1)
         f.write("\n")
