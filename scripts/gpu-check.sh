@@ -60,8 +60,10 @@ if ((sanitize)); then
     # 500-job soak (hours under the tools; the command's own renders below stand in).
     # Under racecheck also the split that names one GPU twice: two host threads
     # launching into one device do not finish there (memcheck, synccheck and
-    # initcheck run it).
-    skip='*Sigterm*:Soak.*:DeviceFaults.*'
+    # initcheck run it). Left out too: the converged-reference tests (16 renders of
+    # eight scenes per kernel and setting, tens of minutes under the tools; their
+    # kernels are the ones the other GPU tests and the renders below run).
+    skip='*Sigterm*:Soak.*:DeviceFaults.*:*ConvergedReference*'
     [[ $tool == racecheck ]] && skip+=':Split.OneGpuTwice*'
     for t in "$bin"/wavetrace_tests; do
       [[ -x "$t" ]] && runs+=("$t --gtest_brief=1 --gtest_filter=*cuda*:*Cuda*:*Gpu*:*Constant*:-$skip")

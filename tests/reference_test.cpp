@@ -11,9 +11,9 @@
 // normal). A tile's z is its mean's difference from the reference's, over that
 // standard error (inflated by the reference's own noise, test samples / reference
 // samples, and floored at 1e-4 of the value for tiles without noise). Every tile and
-// channel must have |z| < 4.5: over the ~2,600 tiles and channels that one variant
+// channel must have |z| < 4.5: over the 2,304 tiles and channels that one variant
 // tests (all references, both settings), an unbiased renderer fails by chance with
-// probability about 2%, once for all seeds (they are fixed). The whole image's
+// probability about 1.6%, once for all seeds (they are fixed). The whole image's
 // mean, per channel, must have |z| < 4: that is where a small bias everywhere
 // shows, and the test prints the smallest relative bias each image can see (4
 // sigma of its mean; docs/testing.md lists them).
