@@ -19,6 +19,7 @@ namespace {
 
 using test::mean;
 using test::mean_abs_diff;
+using test::expect_mean_within_4_sigma;
 using test::options_for;
 
 RenderResult cornell(Kernel k, int spp, uint32_t seed, int nee, Backend b = Backend::Cpu) {
@@ -76,23 +77,6 @@ std::vector<double> pixel_values(const RenderResult& r) {
   std::vector<double> v;
   for (size_t i = 0; i < r.rgb.size(); i += 3) v.push_back(r.rgb[i] / per_pixel);
   return v;
-}
-
-// The pixels' mean lies within four standard errors of `exact` (the standard error
-// from the pixels' own spread: each pixel is an independent estimate of the same
-// value, up to the tiny patch the camera sees), and four standard errors are at
-// most `power` of it (or of `value`, where `exact` is a difference's 0), so that
-// the test sees a bias that large.
-void expect_mean_within_4_sigma(const std::vector<double>& pixels, double exact, double power,
-                                const std::string& what, double value = -1) {
-  if (value < 0) value = exact;  // `power` is a share of this
-  double sum = 0, sum2 = 0;
-  for (double x : pixels) sum += x, sum2 += x * x;
-  const double n = static_cast<double>(pixels.size());
-  const double mean = sum / n;
-  const double se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1));
-  EXPECT_NEAR(mean, exact, 4 * se) << what << ": mean " << mean << ", standard error " << se;
-  EXPECT_LT(4 * se, power * value) << what << ": too noisy to see a bias of " << power;
 }
 
 // A lamp's light at the tiny patch a 16 x 16 render sees, by the CPU's megakernel
@@ -350,12 +334,7 @@ TEST(SkyLight, AGreySphereUnderAUniformSkyIsItsAlbedo) {
       EXPECT_GT(r.shadow_rays, r.paths * 2 / 5) << "the sphere should fill the frame";
       means.push_back(mean(r.rgb));
     }
-    double m = 0, var = 0;
-    for (double x : means) m += x / means.size();
-    for (double x : means) var += (x - m) * (x - m) / (means.size() - 1);
-    const double se = std::sqrt(var / means.size());
-    EXPECT_NEAR(m, 0.5, 4 * se) << kernel_name(k) << ": standard error " << se;
-    EXPECT_LT(4 * se, 0.005 * 0.5) << kernel_name(k) << ": too noisy to see a bias of 0.5%";
+    expect_mean_within_4_sigma(means, 0.5, 0.005, kernel_name(k));
   }
 }
 

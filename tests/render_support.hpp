@@ -53,6 +53,30 @@ inline RenderOptions options_for(Backend b, Kernel k, int w, int h, int spp, int
 
 inline double mean(const std::vector<float>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); }
 
+// The mean of independent estimates of one value, and its standard error (from
+// their spread).
+struct MeanAndError {
+  double mean, standard_error;
+};
+inline MeanAndError mean_and_standard_error(const std::vector<double>& v) {
+  const double avg = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+  double var = 0;
+  for (double x : v) var += (x - avg) * (x - avg);
+  return MeanAndError{avg, std::sqrt(var / (v.size() - 1) / v.size())};
+}
+
+// The estimates' mean lies within four standard errors of `exact`, and four
+// standard errors are at most `power` of it (or of `value`, where `exact` is a
+// difference's 0), so that the test sees a bias that large.
+inline void expect_mean_within_4_sigma(const std::vector<double>& estimates, double exact, double power,
+                                       const std::string& what, double value = -1) {
+  if (value < 0) value = exact;  // `power` is a share of this
+  const MeanAndError e = mean_and_standard_error(estimates);
+  EXPECT_NEAR(e.mean, exact, 4 * e.standard_error) << what << ": mean " << e.mean << ", standard error "
+                                                    << e.standard_error;
+  EXPECT_LT(4 * e.standard_error, power * value) << what << ": too noisy to see a bias of " << power;
+}
+
 // Image means of renders with two settings that must estimate the same value (one
 // mean per independent seed, at least 16 each): they agree within four standard
 // errors of their difference (each from its own seeds' spread, plus 1e-4 of the
@@ -61,15 +85,8 @@ inline double mean(const std::vector<float>& v) { return std::accumulate(v.begin
 inline void expect_same_expectation(const std::vector<double>& a, const std::vector<double>& b, double power) {
   ASSERT_GE(a.size(), 16u);
   ASSERT_GE(b.size(), 16u);
-  auto stats = [](const std::vector<double>& v, double& avg, double& se) {
-    avg = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
-    double var = 0;
-    for (double x : v) var += (x - avg) * (x - avg);
-    se = std::sqrt(var / (v.size() - 1) / v.size());
-  };
-  double ma, sa, mb, sb;
-  stats(a, ma, sa);
-  stats(b, mb, sb);
+  const MeanAndError ea = mean_and_standard_error(a), eb = mean_and_standard_error(b);
+  const double ma = ea.mean, sa = ea.standard_error, mb = eb.mean, sb = eb.standard_error;
   const double four_sigma = 4.0 * std::sqrt(sa * sa + sb * sb);
   std::printf("[ power     ] 4 sigma of the difference: %.2f%% of the value\n", 100.0 * four_sigma / mb);
   EXPECT_NEAR(ma, mb, four_sigma + 1e-4 * mb) << ma << " +- " << sa << " against " << mb << " +- " << sb;
