@@ -32,11 +32,11 @@ struct RenderParams {
 // signed index lets the compiler fold `i + 1` into the address (references and
 // unsigned indices everywhere cost each intersect kernel 8 PTX instructions). The
 // host scene's members, the host and device views, the upload, the constant-memory
-// layout and its size check, and the device byte count all follow from this list (docs/architecture.md, "Where a new thing goes"). Two
-// things of the scene are not plain arrays and are named where they are used: its
-// images (decoded texels on the host, texture objects on the device) and the
-// environment's sampling table (a struct with a view of its own, kept in global
-// memory by every kernel).
+// layout and its size check, and the device byte count all follow from this list
+// (docs/architecture.md, "Where a new thing goes"). Two things of the scene are not
+// plain arrays and are named where they are used: its images (decoded texels on the
+// host, texture objects on the device) and the environment's sampling table (a
+// struct with a view of its own, kept in global memory by every kernel).
 //
 // The top-level nodes come first, then each tree's; the instances are in top-level
 // order; spheres and triangles are in BVH order, every mesh's triangles one range;
