@@ -169,7 +169,7 @@ TEST_F(JobTest, MissingSceneFileIsBadInputAndWritesNothing) {
 TEST_F(JobTest, UnknownMaterialIsBadInputAndWritesNothing) {
   std::string scene = write("s.json", R"({
     "camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]},
-    "materials": [{"name": "m", "type": "plastic"}],
+    "materials": [{"name": "m", "type": "vinyl"}],
     "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})");
   expect_bad_input(run_job(small_job(scene, path("out.png"))), "/materials/0/type");
   EXPECT_TRUE(only_expected_files({"s.json"}));

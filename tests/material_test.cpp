@@ -1,4 +1,4 @@
-// wt::scatter for every material kind at fixed hits, and shade_hit's Russian
+// Sampling the BSDF (bsdf.hpp) for every study material kind at fixed hits, and shade_hit's Russian
 // roulette, against what each material promises: the hemisphere a diffuse bounce
 // goes to, the mirror law, Fresnel (Schlick) frequencies, Snell's law, where the
 // spawned ray starts, and that roulette leaves the expected throughput unchanged.
@@ -36,6 +36,18 @@ Material make_material(MaterialKind kind, vec3 albedo, float fuzz = 0.0f, float 
   return m;
 }
 
+// One scattering event through the BSDF contract: false where the path ends.
+bool scatter(const Material& m, const Texture* textures, const ImageView* images, const Ray& in,
+             const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
+  if (m.kind == MaterialKind::Emissive) return false;
+  const BsdfAt b = bsdf_at(m, nullptr, nullptr, sp, material_albedo(m, textures, images, sp));
+  const BsdfSample s = sample_bsdf(b, -in.dir, rng);
+  if (s.lobe == 0u) return false;
+  attenuation = s.weight;
+  next = spawn_ray(sp, s.wi);
+  return true;
+}
+
 // A hit on the top of a unit sphere centred at the origin: p = (0, 1, 0), n = +y.
 SurfacePoint top_hit(bool front) {
   SurfacePoint sp;
@@ -44,6 +56,7 @@ SurfacePoint top_hit(bool front) {
   sp.ng = sp.n;
   sp.local = sp.p;
   sp.uv = vec2(0.0f);
+  sp.dpdu = vec3(1.0f, 0.0f, 0.0f);
   sp.has_uv = false;
   sp.front = front;
   sp.offset = kSphereSurfaceOffset;

@@ -420,7 +420,7 @@ TEST(SceneParser, UnknownTypesAreRejected) {
   EXPECT_EQ(error_of_text(with(doc, "/materials/2/type", "plastik").dump()),
             kSource +
                 ": /materials/2/type: unknown material type 'plastik' (expected lambertian, metal, dielectric, "
-                "coated, emissive)");
+                "coated, emissive, conductor, glass, plastic)");
   expect_error(with(doc, "/textures/1/type", "wood"), "/textures/1/type",
                "unknown texture type 'wood' (expected checker, noise, image)");
   expect_error(with(doc, "/sky/type", "hdri"), "/sky/type", "unknown sky type 'hdri' (expected gradient, uniform, environment)");
@@ -622,7 +622,7 @@ TEST(SceneParser, SortKeyBitsHoldEveryMaterialKeyAndNoMore) {
   Scene s = parse_scene(base_scene().dump(), kSource);
   int bits = s.sort_key_bits();
   uint32_t largest = 0;
-  for (const Material& m : s.materials) largest = std::max(largest, m.sort_key);
+  for (const Material& m : s.materials) largest = std::max(largest, static_cast<uint32_t>(m.sort_key));
   EXPECT_GT(1u << bits, largest);
   if (largest > 0) {
     EXPECT_LE(1u << (bits - 1), largest);  // no more bits than that

@@ -66,36 +66,15 @@ struct ShadowRay {
 // count the emitter's own surface as what blocks them.
 constexpr float kShadowShorten = 1e-4f;
 
-// What light sampling needs of the surface at a hit: the density with which its
-// BSDF samples a direction. For every surface light-sampled here, the BSDF times
-// the cosine is the albedo times that density, so one function serves both: a
-// Lambertian lobe's cos / pi, scaled by its share `diffuse` of the reflection, or a
-// fuzzy metal's lobe about its mirror direction (metal_fuzz_pdf; the directions it
-// would send below the surface are absorbed, so they carry nothing either way).
-struct ScatterDensity {
-  vec3 facing_n;
-  float diffuse;   // the diffuse share: 1 for Lambertian; 1 - Fresnel for a coat's base; 0: none
-  vec3 reflected;  // a fuzzy metal's mirror direction
-  float fuzz;      // > 0: a fuzzy metal (diffuse is then 0)
-
-  WT_HD float operator()(const vec3& dir) const {
-    const float cos_n = glm::dot(dir, facing_n);
-    const float density = fuzz > 0.0f ? (cos_n > 0.0f ? metal_fuzz_pdf(reflected, fuzz, dir) : 0.0f)
-                                      : diffuse * fmaxf(cos_n, 0.0f) * (1.0f / kPi);
-    return WT_MUTANT(BsdfPdfScaled) ? 1.05f * density : density;
-  }
-  WT_HD bool samples_lights() const { return diffuse > 0.0f || fuzz > 0.0f; }
-};
-
 // Next-event estimation at a hit: one light picked by power (an emitter, or the
 // sky), one point or direction on it, and its contribution weighted against the
-// BSDF's sampling of the same direction (the power heuristic). Lambertian surfaces,
-// the diffuse base of coated ones and fuzzy metals are light-sampled; specular ones
-// (dielectric, mirror metal, a coat's mirror reflection) are not, and the paths
-// they scatter count what they hit in full.
+// BSDF's sampling of the same direction (the power heuristic). Taken where the BSDF
+// has a lobe that is not a delta (bsdf_samples_lights); the paths that specular
+// lobes scatter count what they hit in full. A BSDF that only reflects looks for
+// lights on wo's side of the surface; one that transmits looks on both.
 template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, const SurfacePoint& sp,
-                                       const ScatterDensity& bsdf, const vec3& throughput, const Rng& rng) {
+WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, const SurfacePoint& sp,
+                                       const vec3& wo, const vec3& throughput, const Rng& rng) {
   ShadowRay out{};
   out.valid = false;
   float pick;
@@ -103,12 +82,13 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, c
   if (!(pick > 0.0f)) return out;
   const float u1 = rng.uniform(WT_MUTANT(DimensionReused) ? kDimLightPick : kDimLightA), u2 = rng.uniform(kDimLightB);
   const vec3 outward = sp.front ? sp.ng : -sp.ng;
+  const bool either_side = bsdf_transmits(bsdf);
   vec3 emitted;
   float drawn_pdf;  // the density the direction was drawn with, times the picking probability
   float light_pdf;  // light_density's (or sky_light_density's) for it, for the MIS weight
   if (light.instance == kSkyLight) {
     const SkyDirection d = sample_sky_direction(scene.sky, scene.environment_table(), u1, u2);
-    if (!(d.pdf > 0.0f) || glm::dot(d.dir, outward) <= 0.0f) return out;
+    if (!(d.pdf > 0.0f) || (!either_side && glm::dot(d.dir, outward) <= 0.0f)) return out;
     out.ray = spawn_ray(sp, d.dir);
     out.tmax = kRayTMax;
     emitted = scene.sky.radiance(d.dir, scene.image_array());
@@ -116,7 +96,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, c
   } else {
     const EmitterShape shape = emitter_shape<Kinds>(scene, light.instance, light.prim);
     const LightSample s = shape.sample(sp.p, u1, u2);
-    if (!(s.pdf > 0.0f) || glm::dot(s.dir, outward) <= 0.0f) return out;
+    if (!(s.pdf > 0.0f) || (!either_side && glm::dot(s.dir, outward) <= 0.0f)) return out;
     emitted = scene.material(material_index<Kinds>(scene, Hit{s.dist, light.instance, light.prim, 0.0f, 0.0f}))
                   .emission;
     // The shadow ray leaves from the offset a ray leaving the surface starts at, and
@@ -133,11 +113,11 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const vec3& albedo, c
     drawn_pdf = pick * s.pdf;
     light_pdf = light_density(scene, emitted, shape, out.ray.origin, out.ray.dir, length);
   }
-  const float bsdf_pdf = bsdf(out.ray.dir);
+  float bsdf_pdf;
+  vec3 f_cos = eval_bsdf(bsdf, wo, out.ray.dir, bsdf_pdf);
   if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
-  // BSDF x cos = albedo x bsdf_pdf (ScatterDensity).
-  const float f_cos = WT_MUTANT(MissingCosine) ? bsdf_pdf / fmaxf(glm::dot(out.ray.dir, bsdf.facing_n), 1e-3f) : bsdf_pdf;
-  out.contribution = throughput * albedo * emitted * (f_cos * power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
+  if (WT_MUTANT(MissingCosine)) f_cos *= 1.0f / fmaxf(fabsf(glm::dot(out.ray.dir, bsdf.facing_n())), 1e-3f);
+  out.contribution = throughput * f_cos * emitted * (power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
 }
@@ -165,33 +145,22 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   }
   const SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
-  const vec3 facing_n = sp.front ? sp.n : -sp.n;
-  // The diffuse share of the surface's reflection (scatter_coated draws the coat's
-  // mirror with Schlick's probability from the front, and the base otherwise).
-  const float coat = m.kind == MaterialKind::Coated && sp.front
-                         ? schlick(fminf(-glm::dot(ray.dir, facing_n), 1.0f), 1.0f / m.ior)
-                         : 0.0f;
-  const bool fuzzy = nee && m.kind == MaterialKind::Metal && m.fuzz > 0.0f;
-  const ScatterDensity bsdf{
-      facing_n, m.kind == MaterialKind::Lambertian ? 1.0f : (m.kind == MaterialKind::Coated ? 1.0f - coat : 0.0f),
-      fuzzy ? reflect(ray.dir, facing_n) : vec3(0.0f), fuzzy ? m.fuzz : 0.0f};
+  const vec3 wo = -ray.dir;
+  const BsdfAt bsdf = bsdf_at(m, scene.material_param_array(), scene.bsdf_table_array(), sp,
+                              material_albedo(m, scene.texture_array(), scene.image_array(), sp));
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
-  const vec3 albedo = material_albedo(m, scene.texture_array(), scene.image_array(), sp);
-  if (nee && bsdf.samples_lights() && static_cast<int>(bounce) + 1 < rp.depth) {
-    shadow = sample_light<Kinds>(scene, albedo, sp, bsdf, throughput, rng);
+  if (nee && bsdf_samples_lights(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
+    shadow = sample_light<Kinds>(scene, bsdf, sp, wo, throughput, rng);
   }
-  vec3 attenuation;
-  Ray next;
-  if (!scatter_with_albedo(m, albedo, ray, sp, rng, attenuation, next)) return false;
-  // The density of the direction the path goes on in, where the BSDF has one (the
-  // diffuse lobe's, the fuzzy metal's); 0 after a mirror-like bounce (the coat's,
-  // when it was drawn).
-  const bool mirrored = m.kind == MaterialKind::Coated && sp.front && rng.uniform(kDimLayer) < coat;
-  // (Only light sampling's MIS weights read it.)
-  pdf = nee && !mirrored ? bsdf(next.dir) : 0.0f;
-  throughput *= attenuation;
+  const BsdfSample s = sample_bsdf(bsdf, wo, rng);
+  if (s.lobe == 0u) return false;
+  const Ray next = spawn_ray(sp, s.wi);
+  // The density of the direction the path goes on in, for the MIS weight of what it
+  // hits: 0 after a specular lobe. (Only light sampling reads it.)
+  pdf = nee && !(s.lobe & kLobeSpecular) ? s.pdf : 0.0f;
+  throughput *= s.weight;
   if (static_cast<int>(bounce) + 1 >= rp.roulette_depth) {
     // Survive with probability p and divide by it: the expectation is unchanged.
     float p = fminf(fmaxf(throughput.x, fmaxf(throughput.y, throughput.z)), 0.95f);

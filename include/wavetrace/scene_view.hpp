@@ -5,7 +5,7 @@
 #include "wavetrace/distribution.hpp"
 #include "wavetrace/geometry/geometry.hpp"
 #include "wavetrace/lights.hpp"
-#include "wavetrace/material.hpp"
+#include "wavetrace/bsdf.hpp"
 #include "wavetrace/sky.hpp"
 
 namespace wt {
@@ -40,7 +40,9 @@ struct RenderParams {
 //
 // The top-level nodes come first, then each tree's; the instances are in top-level
 // order; spheres and triangles are in BVH order, every mesh's triangles one range;
-// normals and uvs are per vertex, of the meshes that have them; the lights are every
+// normals and uvs are per vertex, of the meshes that have them; material_params
+// hold the microfacet kinds' parameters and bsdf_tables their energy tables
+// (bsdfs/energy.hpp); the lights are every
 // emitter, for next-event estimation, and light_cdf[i] the probability of picking
 // lights 0..i.
 #define WT_SCENE_ARRAYS(X)                                                        \
@@ -54,6 +56,8 @@ struct RenderParams {
   X(vec3, normals, normal, vec3, uint32_t)                                        \
   X(vec2, uvs, uv, vec2, uint32_t)                                                \
   X(Material, materials, material, const Material&, uint32_t)                     \
+  X(MaterialParams, material_params, material_param, const MaterialParams&, int)  \
+  X(float, bsdf_tables, bsdf_table, float, int)                                   \
   X(Texture, textures, texture, const Texture&, uint32_t)                         \
   X(LightRef, lights, light, LightRef, int)                                       \
   X(float, light_cdf, light_cdf_at, float, int)
@@ -92,8 +96,10 @@ struct SceneView : SceneScalars {
   const ImageView* images;
 
   WT_SCENE_ARRAYS(WT_SCENE_VIEW_AT)
-  // The texture code takes the textures and the images whole.
+  // The texture and BSDF code take these arrays whole.
   WT_HD const Texture* texture_array() const { return textures; }
+  WT_HD const MaterialParams* material_param_array() const { return material_params; }
+  WT_HD const float* bsdf_table_array() const { return bsdf_tables; }
   WT_HD const ImageView* image_array() const { return images; }
 };
 

@@ -41,6 +41,10 @@ struct ConstantScene : SceneScalars {
   }
   WT_SCENE_ARRAYS(WT_CONSTANT_AT)
   __device__ const Texture* texture_array() const { return pool_array<Texture>(layout.textures); }
+  __device__ const MaterialParams* material_param_array() const {
+    return pool_array<MaterialParams>(layout.material_params);
+  }
+  __device__ const float* bsdf_table_array() const { return pool_array<float>(layout.bsdf_tables); }
   __device__ const ImageView* image_array() const { return pool_array<ImageView>(layout.images); }
 };
 #undef WT_CONSTANT_AT

@@ -148,7 +148,7 @@ Material make_material(MaterialKind kind, vec3 albedo, float fuzz, float ior, ve
   m.fuzz = kind == MaterialKind::Metal ? std::clamp(fuzz, 0.0f, 1.0f) : 0.0f;
   m.ior = kind == MaterialKind::Dielectric || kind == MaterialKind::Coated ? ior : 1.0f;
   m.emission = kind == MaterialKind::Emissive ? emission : vec3(0.0f);
-  m.sort_key = material_sort_key(kind, -1);
+  m.sort_key = static_cast<uint8_t>(material_sort_key(kind, -1));
   return m;
 }
 

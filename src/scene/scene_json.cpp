@@ -148,7 +148,7 @@ Scene load_scene(const std::string& path) {
 // Compact drops the misses before the sort, so only the materials' keys count.
 int Scene::sort_key_bits() const {
   uint32_t largest = 0;
-  for (const Material& m : materials) largest = std::max(largest, m.sort_key);
+  for (const Material& m : materials) largest = std::max(largest, static_cast<uint32_t>(m.sort_key));
   int bits = 0;
   while ((largest >> bits) != 0) ++bits;
   return std::max(bits, 1);

@@ -86,7 +86,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         t.kind = TextureKind::Image;
         t.image = image_file(mm.albedo_map, true, mesh.source);
         m.texture = static_cast<int32_t>(scene_.textures.size());
-        m.sort_key = material_sort_key(m.kind, static_cast<int>(TextureKind::Image));
+        m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, static_cast<int>(TextureKind::Image)));
         scene_.textures.push_back(t);
       }
       material_of[i] = static_cast<uint32_t>(scene_.materials.size());

@@ -66,6 +66,7 @@ class SceneReader : JsonReader {
 
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);
+  void read_microfacet(const json& j, const JsonPath& path, Material& m);
 
   // scene_geometry.cpp
   void read_sphere(const json& j, const JsonPath& path);
@@ -86,6 +87,7 @@ class SceneReader : JsonReader {
   std::filesystem::path base_dir_;
   Names texture_names_;
   Names material_names_;
+  int32_t conductor_table_ = -1;  // where the conductors' shared table is in bsdf_tables (-1: not yet)
   Names mesh_names_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;

@@ -218,11 +218,19 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
       if (glm::dot(sp.n, sp.ng) < 0.0f) sp.ng = -sp.ng;
     }
   }
+  const vec3 e1 = tri.corner(1) - tri.corner(0), e2 = tri.corner(2) - tri.corner(0);
+  vec3 dpdu = e1;
   if (sh.flags & kTriangleHasUvs) {
-    sp.uv = b0 * g.uv(sh.vertex[0]) + hit.b1 * g.uv(sh.vertex[1]) + hit.b2 * g.uv(sh.vertex[2]);
+    const vec2 t0 = g.uv(sh.vertex[0]), t1 = g.uv(sh.vertex[1]), t2 = g.uv(sh.vertex[2]);
+    sp.uv = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
+    // dp/du from p(u, v) over the triangle: solve the UV deltas of the two edges.
+    const vec2 d1 = t1 - t0, d2 = t2 - t0;
+    const float det = d1.x * d2.y - d1.y * d2.x;
+    if (det != 0.0f) dpdu = (d2.y * e1 - d1.y * e2) * (1.0f / det);
   } else {
     sp.uv = vec2(hit.b1, hit.b2);
   }
+  sp.dpdu = in.identity ? dpdu : in.world_from_object.vector(dpdu);
   sp.has_uv = true;
   sp.front = glm::dot(ray.dir, sp.ng) < 0.0f;
   // The point's error along the normal, and the rounding of adding the offset to it

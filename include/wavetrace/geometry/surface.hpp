@@ -12,6 +12,8 @@ struct SurfacePoint {
   vec3 ng;      // unit geometric normal, outward
   vec3 local;   // object-space position (procedural textures): relative to a sphere's centre
   vec2 uv;      // texture coordinates (triangles); spheres map theirs from n (texture.hpp)
+  vec3 dpdu;    // the direction of increasing u (not unit; anisotropy's tangent): a
+                // sphere's azimuth, a triangle's from its UVs (its first edge without them)
   bool has_uv;  // false: spheres
   bool front;   // the ray arrived from the outward side
   float offset;  // how far a secondary ray starts from p along ng: covers p's rounding error

@@ -1,0 +1,119 @@
+// The BSDF contract: the one place that switches on a material's kind. Every kind
+// is a header of its own under bsdfs/, giving
+//   sample(wo, rng) -> wi, weight = f cos / pdf, pdf and the lobe (BsdfSample),
+//   eval(wo, wi)    -> f |cos theta_i|,
+//   pdf(wo, wi)     -> the density with which sample draws wi,
+// with eval and pdf zero for specular (delta) lobes, which light sampling skips.
+// The light transport (path.hpp) uses only these functions. Adding a kind touches
+// its header, the switches here, the scene reader's table of kinds and the docs.
+#pragma once
+
+#include "wavetrace/bsdfs/coated.hpp"
+#include "wavetrace/bsdfs/conductor.hpp"
+#include "wavetrace/bsdfs/dielectric.hpp"
+#include "wavetrace/bsdfs/glass.hpp"
+#include "wavetrace/bsdfs/lambertian.hpp"
+#include "wavetrace/bsdfs/metal.hpp"
+#include "wavetrace/bsdfs/plastic.hpp"
+#include "wavetrace/mutant.hpp"
+
+namespace wt {
+
+// The BSDF of material m at sp, its albedo there being `albedo` (material_albedo).
+// `params` and `tables`: the scene's material_params and bsdf_tables.
+WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const MaterialParams* params, const float* tables,
+                               const SurfacePoint& sp, const vec3& albedo) {
+  BsdfAt b;
+  b.kind = m.kind;
+  b.flags = m.flags;
+  b.fuzz = m.fuzz;
+  b.ior = m.ior;
+  b.albedo = albedo;
+  if (m.params >= 0) {
+    b.p = params[m.params];
+  } else {
+    b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f)};
+  }
+  b.n = sp.n;
+  b.ng = sp.ng;
+  b.dpdu = sp.dpdu;
+  b.front = sp.front;
+  b.tables = tables;
+  return b;
+}
+
+WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rng& rng) {
+  switch (b.kind) {
+    case MaterialKind::Lambertian: return lambertian_sample(b, wo, rng);
+    case MaterialKind::Metal: return metal_sample(b, wo, rng);
+    case MaterialKind::Dielectric: return dielectric_sample(b, wo, rng);
+    case MaterialKind::Coated: return coated_sample(b, wo, rng);
+    case MaterialKind::Conductor: return conductor_sample(b, wo, rng);
+    case MaterialKind::Glass: return glass_sample(b, wo, rng);
+    case MaterialKind::Plastic: return plastic_sample(b, wo, rng);
+    case MaterialKind::Emissive: break;
+  }
+  return no_sample();
+}
+
+// f cos for wi, and (in `pdf`) the density sample_bsdf draws it with.
+WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
+  pdf = 0.0f;
+  vec3 f(0.0f);
+  switch (b.kind) {
+    case MaterialKind::Lambertian:
+      pdf = lambertian_pdf(b, wo, wi);
+      f = lambertian_eval(b, wo, wi);
+      break;
+    case MaterialKind::Metal:
+      pdf = metal_pdf(b, wo, wi);
+      f = metal_eval(b, wo, wi);
+      break;
+    case MaterialKind::Coated:
+      pdf = coated_pdf(b, wo, wi);
+      f = coated_eval(b, wo, wi);
+      break;
+    case MaterialKind::Conductor:
+      pdf = conductor_pdf(b, wo, wi);
+      f = conductor_eval(b, wo, wi);
+      break;
+    case MaterialKind::Glass: f = glass_eval(b, wo, wi, pdf); break;
+    case MaterialKind::Plastic: f = plastic_eval(b, wo, wi, pdf); break;
+    case MaterialKind::Dielectric:
+    case MaterialKind::Emissive: break;
+  }
+  if (WT_MUTANT(BsdfPdfScaled)) pdf *= 1.05f;
+  return f;
+}
+
+WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi) {
+  float pdf;
+  return eval_bsdf(b, wo, wi, pdf);
+}
+
+WT_HD WT_INLINE float pdf_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi) {
+  float pdf;
+  eval_bsdf(b, wo, wi, pdf);
+  return pdf;
+}
+
+// Whether the BSDF has a lobe that is not a delta, which light sampling can reach.
+WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
+  switch (b.kind) {
+    case MaterialKind::Lambertian:
+    case MaterialKind::Coated:
+    case MaterialKind::Plastic: return true;
+    case MaterialKind::Metal: return b.fuzz > 0.0f;
+    case MaterialKind::Conductor: return !Ggx{b.p.ax, b.p.ay}.smooth();
+    case MaterialKind::Glass: return !(b.flags & kMaterialThin) && !Ggx{b.p.ax, b.p.ay}.smooth();
+    case MaterialKind::Dielectric:
+    case MaterialKind::Emissive: break;
+  }
+  return false;
+}
+
+// Whether the BSDF can send light through the surface (light sampling then looks
+// on both sides of it).
+WT_HD WT_INLINE bool bsdf_transmits(const BsdfAt& b) { return b.kind == MaterialKind::Glass; }
+
+}  // namespace wt

@@ -1,0 +1,105 @@
+// `conductor`: a GGX microfacet metal (anisotropic, height-correlated Smith masking,
+// visible-normal sampling), with Fresnel from a complex index per channel or from
+// Schlick's f0, and (kMaterialCompensated) the energy that single scattering loses
+// put back by a diffuse-like multiple-scattering lobe (Kulla and Conty 2017,
+// "Revisiting physically based shading at Imageworks"):
+//   f_ms cos = multiple (1 - E(mu_o)) (1 - E(mu_i)) mu_i / pi,
+// with E the GGX directional albedo at F = 1 (energy.hpp) and `multiple` =
+// F_avg^2 E_avg / ((1 - E_avg)(1 - F_avg (1 - E_avg))) per channel, so that a white
+// conductor (F = 1) reflects all that reaches it. Two-sided.
+#pragma once
+
+#include "wavetrace/bsdfs/common.hpp"
+#include "wavetrace/bsdfs/energy.hpp"
+#include "wavetrace/bsdfs/microfacet.hpp"
+
+namespace wt {
+
+WT_HD WT_INLINE vec3 conductor_fresnel(const BsdfAt& b, float cos_i) {
+  return (b.flags & kMaterialSchlick) ? schlick_f0(cos_i, b.p.eta) : fresnel_conductor(cos_i, b.p.eta, b.p.k);
+}
+
+// The roughness the energy table is read at: that of the isotropic lobe of equal
+// alpha_x alpha_y.
+WT_HD WT_INLINE float conductor_table_roughness(const Ggx& g) { return sqrtf(sqrtf(g.ax * g.ay)); }
+
+WT_HD WT_INLINE bool conductor_compensated(const BsdfAt& b) {
+  return (b.flags & kMaterialCompensated) != 0 && b.p.table >= 0;
+}
+
+// The probability of sampling the multiple-scattering lobe: the share single
+// scattering misses at mu_o.
+WT_HD WT_INLINE float conductor_multiple_share(const BsdfAt& b, const Ggx& g, float mu_o) {
+  if (!conductor_compensated(b)) return 0.0f;
+  return 1.0f - conductor_energy(b.tables + b.p.table, conductor_table_roughness(g), mu_o);
+}
+
+// Local frame (z = the facing shading normal); wo.z > 0.
+WT_HD WT_INLINE vec3 conductor_eval_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
+  const vec3 h = glm::normalize(wo + wi);
+  vec3 f = conductor_fresnel(b, glm::dot(wo, h)) * (g.d(h) * g.g2(wo, wi) / (4.0f * wo.z));
+  if (conductor_compensated(b)) {
+    const float* t = b.tables + b.p.table;
+    const float r = conductor_table_roughness(g);
+    f += b.p.multiple * ((1.0f - conductor_energy(t, r, wo.z)) * (1.0f - conductor_energy(t, r, wi.z)) * wi.z / kPi);
+  }
+  return f;
+}
+
+WT_HD WT_INLINE float conductor_pdf_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  const vec3 h = glm::normalize(wo + wi);
+  const float q = conductor_multiple_share(b, g, wo.z);
+  const float single = g.visible_d(wo, h) / (4.0f * glm::dot(wo, h));
+  if (!(q > 0.0f)) return single;
+  const float multiple =
+      conductor_multiple_density(b.tables + b.p.table, conductor_table_roughness(g), wi.z) * (0.5f / kPi);
+  return (1.0f - q) * single + q * multiple;
+}
+
+WT_HD WT_INLINE Ggx conductor_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay}; }
+
+WT_HD WT_INLINE BsdfSample conductor_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
+  const Frame fr = b.facing_frame();
+  const vec3 wo = fr.to_local(wo_world);
+  if (wo.z <= 0.0f) return no_sample();
+  const Ggx g = conductor_ggx(b);
+  if (g.smooth()) {
+    const vec3 wi = fr.to_world(vec3(-wo.x, -wo.y, wo.z));
+    if (!b.same_side(wi)) return no_sample();
+    return BsdfSample{wi, conductor_fresnel(b, wo.z), 0.0f, kLobeSpecular | kLobeReflection};
+  }
+  vec3 wi;
+  if (rng.uniform(kDimLayer) < conductor_multiple_share(b, g, wo.z)) {
+    // The multiple-scattering lobe, by its shape in mu_i (energy.hpp) and uniform in azimuth.
+    float density;
+    const float mu = conductor_multiple_cosine(b.tables + b.p.table, conductor_table_roughness(g),
+                                               rng.uniform(kDimScatterA), density);
+    const float sin_t = sqrtf(fmaxf(0.0f, 1.0f - mu * mu)), phi = 2.0f * kPi * rng.uniform(kDimScatterB);
+    wi = vec3(sin_t * cosf(phi), sin_t * sinf(phi), mu);
+  } else {
+    wi = reflect_about(wo, g.sample_visible(wo, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB)));
+  }
+  const float pdf = conductor_pdf_local(b, g, wo, wi);
+  if (!(pdf > 0.0f)) return no_sample();
+  const vec3 wi_world = fr.to_world(wi);
+  if (!b.same_side(wi_world)) return no_sample();
+  return BsdfSample{wi_world, conductor_eval_local(b, g, wo, wi) * (1.0f / pdf), pdf, kLobeGlossy | kLobeReflection};
+}
+
+WT_HD WT_INLINE vec3 conductor_eval(const BsdfAt& b, const vec3& wo, const vec3& wi) {
+  const Ggx g = conductor_ggx(b);
+  if (g.smooth()) return vec3(0.0f);
+  const Frame fr = b.facing_frame();
+  return conductor_eval_local(b, g, fr.to_local(wo), fr.to_local(wi));
+}
+
+WT_HD WT_INLINE float conductor_pdf(const BsdfAt& b, const vec3& wo, const vec3& wi) {
+  const Ggx g = conductor_ggx(b);
+  if (g.smooth()) return 0.0f;
+  const Frame fr = b.facing_frame();
+  return conductor_pdf_local(b, g, fr.to_local(wo), fr.to_local(wi));
+}
+
+}  // namespace wt

@@ -1,0 +1,199 @@
+// The microfacet tables: quasi-Monte Carlo integrals over visible normals
+// (Hammersley points), which make every table the same on every run.
+#include "scene/bsdf_tables.hpp"
+
+#include <cmath>
+
+namespace wt {
+namespace {
+
+constexpr int kNormals = 1024;  // visible normals per table entry
+
+float radical_inverse(uint32_t bits) {
+  bits = (bits << 16) | (bits >> 16);
+  bits = ((bits & 0x55555555u) << 1) | ((bits & 0xaaaaaaaau) >> 1);
+  bits = ((bits & 0x33333333u) << 2) | ((bits & 0xccccccccu) >> 2);
+  bits = ((bits & 0x0f0f0f0fu) << 4) | ((bits & 0xf0f0f0f0u) >> 4);
+  bits = ((bits & 0x00ff00ffu) << 8) | ((bits & 0xff00ff00u) >> 8);
+  return static_cast<float>(bits) * 2.3283064e-10f;
+}
+
+// The grid's cosine j, kept off the horizon.
+float grid_cosine(int j) { return std::fmax(static_cast<float>(j) / (kEnergySize - 1), 1e-3f); }
+
+vec3 view_at(float mu) { return vec3(std::sqrt(std::fmax(0.0f, 1.0f - mu * mu)), 0.0f, mu); }
+
+// The mean over visible normals seen from wo (wo.z > 0) of `weight`(wo, h).
+template <class Weight>
+double mean_over_normals(const Ggx& g, const vec3& wo, Weight weight) {
+  double sum = 0.0;
+  for (int i = 0; i < kNormals; ++i) {
+    const float u1 = (static_cast<float>(i) + 0.5f) / kNormals, u2 = radical_inverse(static_cast<uint32_t>(i));
+    sum += weight(wo, g.sample_visible(wo, u1, u2));
+  }
+  return sum / kNormals;
+}
+
+// G2 / G1 of the reflection about h, which f cos / pdf is when F = 1.
+float reflected_weight(const Ggx& g, const vec3& wo, const vec3& h) {
+  const vec3 wi = reflect_about(wo, h);
+  return wi.z > 0.0f ? g.g2(wo, wi) / g.g1(wo) : 0.0f;
+}
+
+float refracted_weight(const Ggx& g, const vec3& wo, const vec3& h, float eta) {
+  const float c = glm::dot(wo, h);
+  const float cos_t = refracted_cos(c, eta);
+  const vec3 wi = -wo * (1.0f / eta) + (c / eta - cos_t) * h;
+  return wi.z < 0.0f ? g.g2(wo, wi) / g.g1(wo) : 0.0f;
+}
+
+// 2 int_0^1 table(mu) mu dmu, the table read as the renderer reads it.
+float cosine_average(const float* t) {
+  constexpr int kSteps = 1024;
+  double sum = 0.0;
+  for (int i = 0; i < kSteps; ++i) {
+    const float mu = (i + 0.5f) / kSteps;
+    sum += cosine_table(t, mu) * mu;
+  }
+  return static_cast<float>(2.0 * sum / kSteps);
+}
+
+template <class F>
+double cosine_weighted_mean(F f) {
+  constexpr int kSteps = 1024;
+  double sum = 0.0;
+  for (int i = 0; i < kSteps; ++i) {
+    const float mu = (i + 0.5f) / kSteps;
+    sum += f(mu) * mu;
+  }
+  return 2.0 * sum / kSteps;
+}
+
+std::vector<float> make_conductor_table() {
+  std::vector<float> t(kConductorTableFloats);
+  for (int i = 0; i < kEnergySize; ++i) {
+    const float r = static_cast<float>(i) / (kEnergySize - 1);
+    const Ggx g{r * r, r * r};
+    float* row = t.data() + i * kEnergySize;
+    for (int j = 0; j < kEnergySize; ++j) {
+      row[j] = g.smooth() ? 1.0f
+                          : static_cast<float>(mean_over_normals(g, view_at(grid_cosine(j)), [&](const vec3& wo, const vec3& h) {
+                              return reflected_weight(g, wo, h);
+                            }));
+    }
+    t[kConductorAverage + i] = cosine_average(row);
+    // The multiple-scattering lobe's shape (1 - E) mu over equal cells of mu, by
+    // the midpoint of each, accumulated.
+    float* cdf = t.data() + kConductorCdf + i * (kEnergySize + 1);
+    double total = 0.0;
+    std::vector<double> w(kEnergySize);
+    for (int j = 0; j < kEnergySize; ++j) {
+      const float mu = (j + 0.5f) / kEnergySize;
+      w[j] = std::fmax(0.0f, 1.0f - cosine_table(row, mu)) * mu;
+      total += w[j];
+    }
+    double run = 0.0;
+    cdf[0] = 0.0f;
+    for (int j = 0; j < kEnergySize; ++j) {
+      run += total > 0.0 ? w[j] / total : 1.0 / kEnergySize;
+      cdf[j + 1] = static_cast<float>(run);
+    }
+    cdf[kEnergySize] = 1.0f;
+  }
+  return t;
+}
+
+// The rough coat's directional albedo with Fresnel, at index eta (transmitted over
+// incident), from the side wo is on.
+float coat_albedo(const Ggx& g, float eta, float mu) {
+  return static_cast<float>(mean_over_normals(g, view_at(mu), [&](const vec3& wo, const vec3& h) {
+    return fresnel_dielectric(glm::dot(wo, h), eta) * reflected_weight(g, wo, h);
+  }));
+}
+
+}  // namespace
+
+const std::vector<float>& conductor_energy_table() {
+  static const std::vector<float> table = make_conductor_table();
+  return table;
+}
+
+float conductor_multiple_scale(float f_avg, float e_avg) {
+  if (!(1.0f - e_avg > 1e-5f)) return 0.0f;
+  return f_avg * f_avg * e_avg / ((1.0f - e_avg) * (1.0f - f_avg * (1.0f - e_avg)));
+}
+
+vec3 conductor_average_fresnel(const vec3& eta, const vec3& k, bool schlick) {
+  vec3 out;
+  for (int c = 0; c < 3; ++c) {
+    out[c] = static_cast<float>(cosine_weighted_mean([&](float mu) {
+      return schlick ? schlick_f0(mu, eta)[c] : fresnel_conductor(mu, eta[c], k[c]);
+    }));
+  }
+  return out;
+}
+
+std::vector<float> glass_energy_table(float ior, const Ggx& g) {
+  std::vector<float> t(kGlassTableFloats);
+  for (int side = 0; side < 2; ++side) {
+    const float eta = side == 0 ? ior : 1.0f / ior;
+    for (int j = 0; j < kEnergySize; ++j) {
+      t[side * kEnergySize + j] =
+          static_cast<float>(mean_over_normals(g, view_at(grid_cosine(j)), [&](const vec3& wo, const vec3& h) {
+            const float f = fresnel_dielectric(glm::dot(wo, h), eta);
+            return f * reflected_weight(g, wo, h) + (f < 1.0f ? (1.0f - f) * refracted_weight(g, wo, h, eta) : 0.0f);
+          }));
+    }
+  }
+  return t;
+}
+
+std::vector<float> plastic_transmittance_table(float ior, const Ggx& g) {
+  std::vector<float> t(kPlasticTableFloats);
+  for (int j = 0; j < kEnergySize; ++j) t[j] = 1.0f - coat_albedo(g, ior, grid_cosine(j));
+  return t;
+}
+
+float plastic_internal_reflectance(float ior, const Ggx& g) {
+  if (g.smooth()) {
+    return static_cast<float>(cosine_weighted_mean([&](float mu) { return fresnel_dielectric(mu, 1.0f / ior); }));
+  }
+  // 1 minus the cosine-weighted mean of the transmittance from inside.
+  std::vector<float> inside(kEnergySize);
+  for (int j = 0; j < kEnergySize; ++j) inside[j] = 1.0f - coat_albedo(g, 1.0f / ior, grid_cosine(j));
+  return 1.0f - cosine_average(inside.data());
+}
+
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t& conductor_offset) {
+  const Ggx g{p.ax, p.ay};
+  const bool compensated = (m.flags & kMaterialCompensated) != 0 && !g.smooth();
+  auto append = [&tables](const std::vector<float>& t) {
+    const int32_t at = static_cast<int32_t>(tables.size());
+    tables.insert(tables.end(), t.begin(), t.end());
+    return at;
+  };
+  p.table = -1;
+  p.multiple = vec3(0.0f);
+  switch (m.kind) {
+    case MaterialKind::Conductor:
+      if (compensated) {
+        if (conductor_offset < 0) conductor_offset = append(conductor_energy_table());
+        p.table = conductor_offset;
+        const float e_avg = conductor_average_energy(conductor_energy_table().data(), conductor_table_roughness(g));
+        const vec3 f_avg = conductor_average_fresnel(p.eta, p.k, (m.flags & kMaterialSchlick) != 0);
+        for (int c = 0; c < 3; ++c) p.multiple[c] = conductor_multiple_scale(f_avg[c], e_avg);
+      }
+      break;
+    case MaterialKind::Glass:
+      if (compensated && !(m.flags & kMaterialThin)) p.table = append(glass_energy_table(m.ior, g));
+      break;
+    case MaterialKind::Plastic:
+      if (!g.smooth()) p.table = append(plastic_transmittance_table(m.ior, g));
+      p.internal = plastic_internal_reflectance(m.ior, g);
+      break;
+    default:
+      break;
+  }
+}
+
+}  // namespace wt

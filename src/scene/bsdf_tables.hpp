@@ -1,0 +1,36 @@
+// The microfacet kinds' tables (bsdfs/energy.hpp), built on the host from the same
+// BSDF code the renderer runs, with the same deterministic points every time, so
+// that every backend reads the same numbers.
+#pragma once
+
+#include <vector>
+
+#include "wavetrace/bsdf.hpp"
+
+namespace wt {
+
+// The conductors' table E(r, mu) and E_avg(r): built once a process.
+const std::vector<float>& conductor_energy_table();
+
+// The scalar Kulla-Conty factor for one channel of average Fresnel f_avg at the
+// average albedo e_avg (0 where single scattering loses nothing).
+float conductor_multiple_scale(float f_avg, float e_avg);
+
+// 2 int_0^1 F(mu) mu dmu of a conductor's Fresnel, per channel.
+vec3 conductor_average_fresnel(const vec3& eta, const vec3& k, bool schlick);
+
+// E(mu) of a rough glass from outside, then from inside (kGlassTableFloats).
+std::vector<float> glass_energy_table(float ior, const Ggx& g);
+
+// The transmittance t(mu) from outside of a rough plastic's coat
+// (kPlasticTableFloats), and the coat's diffuse reflectance from inside.
+std::vector<float> plastic_transmittance_table(float ior, const Ggx& g);
+float plastic_internal_reflectance(float ior, const Ggx& g);
+
+// Fills the material's params for its kind (alphas already set, eta/k or f0 for
+// conductors): the compensation factors, the internal reflectance, and the tables,
+// appended to `tables` (the conductors' shared one once: `conductor_offset` holds
+// where, -1 until then).
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t& conductor_offset);
+
+}  // namespace wt
