@@ -201,7 +201,7 @@ const std::vector<std::string> kRoughnesses = {"0.05", "0.2", "0.5", "1"};
 
 TEST(BsdfChiSquare, ConductorSamplesItsPdf) {
   for (const std::string& r : kRoughnesses) {
-    for (const char* extra : {"", R"(, "anisotropy": 0.8)", R"(, "energy_compensation": false)"}) {
+    for (const char* extra : {"", R"(, "anisotropy": 0.8)", R"(, "energy_compensation": false)", R"(, "masking": "separable")"}) {
       const Case c = material(R"({"name": "m", "type": "conductor", "metal": "gold", "roughness": )" + r + extra + "}");
       for (double deg : kAngles) expect_fits(c, deg);
     }
@@ -210,7 +210,7 @@ TEST(BsdfChiSquare, ConductorSamplesItsPdf) {
 
 TEST(BsdfChiSquare, GlassSamplesItsPdfOnBothSides) {
   for (const std::string& r : {std::string("0.05"), std::string("0.3"), std::string("1")}) {
-    for (const char* extra : {"", R"(, "energy_compensation": false)"}) {
+    for (const char* extra : {"", R"(, "energy_compensation": false, "masking": "separable")"}) {
       const Case c = material(R"({"name": "m", "type": "glass", "ior": 1.5, "roughness": )" + r + extra + "}");
       for (double deg : {0.0, 45.0, 80.0}) {
         expect_fits(c, deg, true);
@@ -315,6 +315,8 @@ TEST(BsdfContract, ReflectionIsReciprocal) {
                            R"({"name": "m", "type": "conductor", "metal": "gold", "roughness": 0.3})",
                            R"({"name": "m", "type": "conductor", "metal": "iron", "roughness": 0.8, "anisotropy": 0.6})",
                            R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": 1, "energy_compensation": true})",
+                           R"({"name": "m", "type": "conductor", "metal": "copper", "roughness": 0.6, "masking": "separable"})",
+                           R"({"name": "m", "type": "glass", "roughness": 0.5, "energy_compensation": false, "masking": "separable"})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})",
                            R"({"name": "m", "type": "glass", "roughness": 0.5, "energy_compensation": false})"}) {
@@ -390,8 +392,8 @@ TEST(BsdfFurnace, NoBsdfReturnsMoreThanItReceives) {
 // at every roughness and angle; without it, GGX at roughness 1 loses over 10% at
 // grazing incidence (what the compensation puts back).
 TEST(BsdfFurnace, AWhiteConductorOfAnyRoughnessReturnsEverything) {
-  for (const char* r : {"0.05", "0.25", "0.5", "0.75", "1"}) {
-    const Case c = material(std::string(R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": )") + r + "}");
+  for (const std::string r : {"0.05", "0.25", "0.5", "0.75", "1", R"(1, "masking": "separable")"}) {
+    const Case c = material(R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": )" + r + "}");
     for (double deg : {0.0, 30.0, 60.0, 80.0, 88.0}) {
       const Furnace f = furnace(c, incident(deg));
       EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";

@@ -47,7 +47,7 @@ TEST(MaterialScene, TheMicrofacetKindsReadTheirFields) {
                     {"name": "ek", "type": "conductor", "eta": [0.2, 0.5, 1.3], "k": [3.4, 2.2, 1.9], "energy_compensation": false},
                     {"name": "glass", "type": "glass", "roughness": 0.2, "tint": [0.9, 0.8, 0.7]},
                     {"name": "thin", "type": "glass", "thin": true, "ior": 1.33},
-                    {"name": "plastic", "type": "plastic", "albedo": [0.2, 0.3, 0.4], "roughness": 0.3})",
+                    {"name": "plastic", "type": "plastic", "albedo": [0.2, 0.3, 0.4], "roughness": 0.3, "masking": "separable"})",
                  R"("spheres": [{"center": [0, 0, 0], "radius": 1, "material": "gold"}])"),
       kSource);
   ASSERT_EQ(s.materials.size(), 6u);
@@ -69,6 +69,8 @@ TEST(MaterialScene, TheMicrofacetKindsReadTheirFields) {
   EXPECT_NEAR(s.materials[3].albedo.z, 0.7f, 1e-6f) << "the tint";
   EXPECT_TRUE(s.materials[4].flags & kMaterialThin);
   EXPECT_EQ(s.materials[5].kind, MaterialKind::Plastic);
+  EXPECT_TRUE(s.materials[5].flags & kMaterialSeparable);
+  EXPECT_FALSE(s.materials[0].flags & kMaterialSeparable) << "height-correlated by default";
   const MaterialParams& plastic = s.material_params[s.materials[5].params];
   EXPECT_GT(plastic.internal, 0.4f) << "a coat of 1.5 reflects about 60% of diffuse light back from inside";
   EXPECT_LT(plastic.internal, 0.7f);
@@ -93,6 +95,7 @@ TEST(MaterialScene, BadFieldsNameTheFieldAndSayWhy) {
            {R"({"name": "m", "type": "glass", "thin": true, "roughness": 0.1})", "/materials/0/thin", "smooth"},
            {R"({"name": "m", "type": "glass", "ior": 0})", "/materials/0/ior", ""},
            {R"({"name": "m", "type": "plastic", "fuzz": 0.1})", "/materials/0", "fuzz"},
+           {R"({"name": "m", "type": "plastic", "masking": "smith"})", "/materials/0/masking", "separable"},
        }) {
     const std::string e = error_of(one_sphere(c.material));
     EXPECT_NE(e.find(std::string(kSource) + ": " + c.where), std::string::npos) << c.material << ": " << e;

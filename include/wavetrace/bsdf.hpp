@@ -104,8 +104,8 @@ WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
     case MaterialKind::Coated:
     case MaterialKind::Plastic: return true;
     case MaterialKind::Metal: return b.fuzz > 0.0f;
-    case MaterialKind::Conductor: return !Ggx{b.p.ax, b.p.ay}.smooth();
-    case MaterialKind::Glass: return !(b.flags & kMaterialThin) && !Ggx{b.p.ax, b.p.ay}.smooth();
+    case MaterialKind::Conductor: return !conductor_ggx(b).smooth();
+    case MaterialKind::Glass: return !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;
   }

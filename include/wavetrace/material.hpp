@@ -25,6 +25,7 @@ enum MaterialFlag : uint16_t {
   kMaterialThin = 1,         // Glass: a thin sheet
   kMaterialSchlick = 2,      // Conductor: Fresnel from f0 (MaterialParams::eta) by Schlick's formula
   kMaterialCompensated = 4,  // Conductor, Glass: the energy lost to multiple scattering is put back
+  kMaterialSeparable = 8,    // Conductor, Glass, Plastic: separable Smith masking (Ggx::separable)
 };
 
 // The parameters of the microfacet kinds (conductor, glass, plastic), one per such

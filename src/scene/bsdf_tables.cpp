@@ -69,11 +69,11 @@ double cosine_weighted_mean(F f) {
   return 2.0 * sum / kSteps;
 }
 
-std::vector<float> make_conductor_table() {
+std::vector<float> make_conductor_table(bool separable) {
   std::vector<float> t(kConductorTableFloats);
   for (int i = 0; i < kEnergySize; ++i) {
     const float r = static_cast<float>(i) / (kEnergySize - 1);
-    const Ggx g{r * r, r * r};
+    const Ggx g{r * r, r * r, separable};
     float* row = t.data() + i * kEnergySize;
     for (int j = 0; j < kEnergySize; ++j) {
       row[j] = g.smooth() ? 1.0f
@@ -113,9 +113,10 @@ float coat_albedo(const Ggx& g, float eta, float mu) {
 
 }  // namespace
 
-const std::vector<float>& conductor_energy_table() {
-  static const std::vector<float> table = make_conductor_table();
-  return table;
+const std::vector<float>& conductor_energy_table(bool separable) {
+  static const std::vector<float> correlated = make_conductor_table(false);
+  static const std::vector<float> uncorrelated = make_conductor_table(true);
+  return separable ? uncorrelated : correlated;
 }
 
 float conductor_multiple_scale(float f_avg, float e_avg) {
@@ -164,8 +165,9 @@ float plastic_internal_reflectance(float ior, const Ggx& g) {
   return 1.0f - cosine_average(inside.data());
 }
 
-void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t& conductor_offset) {
-  const Ggx g{p.ax, p.ay};
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t* conductor_offsets) {
+  const bool separable = (m.flags & kMaterialSeparable) != 0;
+  const Ggx g{p.ax, p.ay, separable};
   const bool compensated = (m.flags & kMaterialCompensated) != 0 && !g.smooth();
   auto append = [&tables](const std::vector<float>& t) {
     const int32_t at = static_cast<int32_t>(tables.size());
@@ -177,9 +179,10 @@ void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>
   switch (m.kind) {
     case MaterialKind::Conductor:
       if (compensated) {
-        if (conductor_offset < 0) conductor_offset = append(conductor_energy_table());
-        p.table = conductor_offset;
-        const float e_avg = conductor_average_energy(conductor_energy_table().data(), conductor_table_roughness(g));
+        if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
+        p.table = conductor_offsets[separable];
+        const float e_avg =
+            conductor_average_energy(conductor_energy_table(separable).data(), conductor_table_roughness(g));
         const vec3 f_avg = conductor_average_fresnel(p.eta, p.k, (m.flags & kMaterialSchlick) != 0);
         for (int c = 0; c < 3; ++c) p.multiple[c] = conductor_multiple_scale(f_avg[c], e_avg);
       }

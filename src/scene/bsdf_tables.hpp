@@ -9,8 +9,9 @@
 
 namespace wt {
 
-// The conductors' table E(r, mu) and E_avg(r): built once a process.
-const std::vector<float>& conductor_energy_table();
+// The conductors' table (energy.hpp) for height-correlated or separable masking:
+// each built once a process.
+const std::vector<float>& conductor_energy_table(bool separable);
 
 // The scalar Kulla-Conty factor for one channel of average Fresnel f_avg at the
 // average albedo e_avg (0 where single scattering loses nothing).
@@ -29,8 +30,8 @@ float plastic_internal_reflectance(float ior, const Ggx& g);
 
 // Fills the material's params for its kind (alphas already set, eta/k or f0 for
 // conductors): the compensation factors, the internal reflectance, and the tables,
-// appended to `tables` (the conductors' shared one once: `conductor_offset` holds
-// where, -1 until then).
-void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t& conductor_offset);
+// appended to `tables` (the conductors' shared ones once: conductor_offsets[0]
+// and [1] hold where the height-correlated and the separable one are, -1 until then).
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t* conductor_offsets);
 
 }  // namespace wt

@@ -30,9 +30,9 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
       {"name", "type", "ior", "albedo"},
       {"name", "type", "albedo", "ior", "texture"},
       {"name", "type", "emission"},
-      {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation"},
-      {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation"},
-      {"name", "type", "albedo", "texture", "ior", "roughness"},
+      {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation", "masking"},
+      {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation", "masking"},
+      {"name", "type", "albedo", "texture", "ior", "roughness", "masking"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -83,6 +83,9 @@ void SceneReader::read_microfacet(const json& j, const JsonPath& path, Material&
   const bool compensate =
       j.contains("energy_compensation") ? boolean(j["energy_compensation"], path / "energy_compensation") : true;
   if (compensate && m.kind != MaterialKind::Plastic) m.flags |= kMaterialCompensated;
+  if (j.contains("masking") && choice(j["masking"], path / "masking", {"height-correlated", "separable"}) == 1) {
+    m.flags |= kMaterialSeparable;
+  }
   if (m.kind == MaterialKind::Conductor) {
     const int given = (j.contains("metal") ? 1 : 0) + (j.contains("eta") || j.contains("k") ? 1 : 0) +
                       (j.contains("f0") ? 1 : 0);
@@ -117,7 +120,7 @@ void SceneReader::read_microfacet(const json& j, const JsonPath& path, Material&
       m.flags |= kMaterialThin;
     }
   }
-  prepare_microfacet(m, p, scene_.bsdf_tables, conductor_table_);
+  prepare_microfacet(m, p, scene_.bsdf_tables, conductor_tables_);
   m.params = static_cast<int32_t>(scene_.material_params.size());
   scene_.material_params.push_back(p);
 }

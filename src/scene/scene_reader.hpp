@@ -87,7 +87,9 @@ class SceneReader : JsonReader {
   std::filesystem::path base_dir_;
   Names texture_names_;
   Names material_names_;
-  int32_t conductor_table_ = -1;  // where the conductors' shared table is in bsdf_tables (-1: not yet)
+  // Where the conductors' shared tables (height-correlated, separable) are in
+  // bsdf_tables (-1: not yet).
+  int32_t conductor_tables_[2] = {-1, -1};
   Names mesh_names_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;

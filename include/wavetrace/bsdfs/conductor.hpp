@@ -58,7 +58,7 @@ WT_HD WT_INLINE float conductor_pdf_local(const BsdfAt& b, const Ggx& g, const v
   return (1.0f - q) * single + q * multiple;
 }
 
-WT_HD WT_INLINE Ggx conductor_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay}; }
+WT_HD WT_INLINE Ggx conductor_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.flags & kMaterialSeparable) != 0}; }
 
 WT_HD WT_INLINE BsdfSample conductor_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   const Frame fr = b.facing_frame();

@@ -17,7 +17,7 @@
 
 namespace wt {
 
-WT_HD WT_INLINE Ggx glass_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay}; }
+WT_HD WT_INLINE Ggx glass_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.flags & kMaterialSeparable) != 0}; }
 
 // 1 / E(mu_o) on wo's side where the glass is compensated, else 1.
 WT_HD WT_INLINE float glass_compensation(const BsdfAt& b, const vec3& wo) {

@@ -17,6 +17,9 @@ constexpr float kSmoothAlpha = 1e-4f;
 
 struct Ggx {
   float ax, ay;
+  // G2 as the product G1(wo) G1(wi) (uncorrelated heights, as Mitsuba 3's
+  // microfacet BSDFs) instead of the height-correlated form, which is the default.
+  bool separable = false;
 
   WT_HD bool smooth() const { return ax < kSmoothAlpha && ay < kSmoothAlpha; }
 
@@ -34,8 +37,11 @@ struct Ggx {
     return 0.5f * (sqrtf(1.0f + a2) - 1.0f);
   }
   WT_HD float g1(const vec3& w) const { return 1.0f / (1.0f + lambda(w)); }
-  // Height-correlated masking-shadowing of the pair.
-  WT_HD float g2(const vec3& wo, const vec3& wi) const { return 1.0f / (1.0f + lambda(wo) + lambda(wi)); }
+  // Masking-shadowing of the pair: height-correlated, or separable.
+  WT_HD float g2(const vec3& wo, const vec3& wi) const {
+    const float lo = lambda(wo), li = lambda(wi);
+    return separable ? 1.0f / ((1.0f + lo) * (1.0f + li)) : 1.0f / (1.0f + lo + li);
+  }
 
   // The density of the visible normal h seen from wo (wo.z > 0), per solid angle of h.
   WT_HD float visible_d(const vec3& wo, const vec3& h) const {

@@ -15,7 +15,7 @@
 
 namespace wt {
 
-WT_HD WT_INLINE Ggx plastic_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay}; }
+WT_HD WT_INLINE Ggx plastic_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.flags & kMaterialSeparable) != 0}; }
 
 // The coat's transmittance at mu from outside.
 WT_HD WT_INLINE float plastic_transmittance(const BsdfAt& b, const Ggx& g, float mu) {
