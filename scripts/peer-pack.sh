@@ -33,7 +33,8 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
 # "scene" is part of libmitsuba.
 PLUGINS="area bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
-obj path perspective plastic ply regular roughconductor shapegroup sphere srgb thinlens twosided uniform"
+obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
+srgb thindielectric thinlens twosided uniform"
 
 py_local=$(command -v python3)
 export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1
@@ -70,7 +71,7 @@ for f in "$mi"/plugins/*.so; do
 done
 # Headers, CMake files, type stubs, tests, byte code; spectral data (srgb.coeff is the
 # spectral variants' RGB upsampling table), conductor IOR tables (the converter's
-# conductors are material 'none') and sun-sky tables.
+# conductors are material 'none' or give eta and k as RGB values) and sun-sky tables.
 rm -rf "$mi/include" "$mi/cmake" "$mi/mitsuba_stubs" "$mi/python/test" "$mi/data" \
        "$dj/include" "$dj/cmake"
 find "$tree" \( -name '__pycache__' -o -name '*.pyi' -o -name 'py.typed' -o -name 'stubs.pat' \) -prune \
@@ -130,7 +131,7 @@ EOF
   cp "$stage"/mitsuba/llvm_ad_rgb.cpython-312-x86_64-linux-gnu.so "$check/site-packages/mitsuba/"
   if PYTHONPATH=$check/site-packages "$py" -c 'import mitsuba as mi; mi.set_variant("llvm_ad_rgb")' 2>/dev/null; then
     [[ -f "$root/scenes/generated/terrain.glb" ]] || python3 "$root/tools/make_terrain.py" >/dev/null
-    for scene in seed57 rtiow-cover cornell-box terrain glossy-lights sky-sun quick; do
+    for scene in seed57 rtiow-cover cornell-box terrain glossy-lights sky-sun quick materials cornell-materials; do
       if ! PYTHONPATH=$check/site-packages "$py" "$root/bench/mitsuba_peer.py" render "$root/scenes/$scene.json" \
           --variant llvm_ad_rgb --mode both --width 32 --height 18 --spp 2 --warmup 0 --repeats 1 \
           >"$build/check-$scene.log" 2>&1; then
