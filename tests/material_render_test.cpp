@@ -74,8 +74,14 @@ TEST(MaterialScene, TheMicrofacetKindsReadTheirFields) {
   const MaterialParams& plastic = s.material_params[s.materials[5].params];
   EXPECT_GT(plastic.internal, 0.4f) << "a coat of 1.5 reflects about 60% of diffuse light back from inside";
   EXPECT_LT(plastic.internal, 0.7f);
-  // Every material its own key, keys in range.
-  for (const Material& m : s.materials) EXPECT_LT(m.sort_key, kSortKeyMiss);
+  // Keys in range; the microfacet kinds' among the mask the wavefront sorts for.
+  for (const Material& m : s.materials) {
+    EXPECT_LT(m.sort_key, kSortKeyMiss);
+    EXPECT_TRUE(kMicrofacetKeyMask & (1u << m.sort_key)) << m.sort_key;
+  }
+  EXPECT_TRUE(s.kernel_kinds() & kMicrofacet) << "the kernels with the microfacet BSDFs";
+  EXPECT_FALSE(parse_scene(one_sphere(R"({"name": "m", "type": "coated", "ior": 1.5})"), kSource).kernel_kinds() &
+               kMicrofacet);
 }
 
 TEST(MaterialScene, BadFieldsNameTheFieldAndSayWhy) {

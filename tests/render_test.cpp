@@ -207,7 +207,8 @@ TEST(KernelAgreement, CpuWavefrontMatchesCpuMegakernel) {
 }
 
 // The sort policy (stages/wavefront.hpp): forced modes always and never sort; the
-// adaptive one sorts a bounce whose hits hold at least kSortMinKeys sort keys.
+// adaptive one sorts a bounce whose hits hold at least kSortMinKeys sort keys, or two
+// with a microfacet kind's among them.
 TEST(SortPolicy, SortsOnlyBouncesWithManyKindsOfShading) {
   EXPECT_TRUE(sorts_bounce(Kernel::WavefrontSorted, 0u));
   EXPECT_FALSE(sorts_bounce(Kernel::WavefrontUnsorted, 0xffffffffu));
@@ -215,6 +216,10 @@ TEST(SortPolicy, SortsOnlyBouncesWithManyKindsOfShading) {
   EXPECT_TRUE(sorts_bounce(Kernel::Wavefront, (1u << kSortMinKeys) - 1u));
   EXPECT_TRUE(sorts_bounce(Kernel::Wavefront, 0x55555u)) << "ten keys, not adjacent";
   EXPECT_FALSE(sorts_bounce(Kernel::Wavefront, 0x80000001u)) << "two keys, far apart";
+  const uint32_t conductor = 1u << material_sort_key(MaterialKind::Conductor, -1);
+  const uint32_t lambertian = 1u << material_sort_key(MaterialKind::Lambertian, -1);
+  EXPECT_TRUE(sorts_bounce(Kernel::Wavefront, conductor | lambertian)) << "a microfacet kind among two keys";
+  EXPECT_FALSE(sorts_bounce(Kernel::Wavefront, conductor)) << "one key alone";
 }
 
 // In whole renders, on both backends' wavefront: quick.json's hits hold eight sort

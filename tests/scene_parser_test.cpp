@@ -652,7 +652,7 @@ TEST(SceneParser, HostViewPointsIntoTheSceneWithTheRendersCamera) {
   EXPECT_EQ(s.spheres.size(), 5u);
   EXPECT_EQ(v.node_count(), static_cast<int>(s.nodes.size()));
   EXPECT_EQ(v.light_count(), static_cast<int>(s.lights.size()));
-  EXPECT_EQ(v.kinds, s.primitive_kinds());
+  EXPECT_EQ(v.kinds, s.kernel_kinds());
   ASSERT_EQ(images.size(), 1u);
   EXPECT_EQ(v.images, images.data());
   EXPECT_EQ(images[0].object, 0u);

@@ -42,21 +42,31 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const MaterialParams* params, 
   return b;
 }
 
+// Microfacet = false: compiled for scenes without the microfacet kinds (a kernel's
+// kMicrofacet bit), whose code it leaves out.
+template <bool Microfacet = true>
 WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rng& rng) {
   switch (b.kind) {
     case MaterialKind::Lambertian: return lambertian_sample(b, wo, rng);
     case MaterialKind::Metal: return metal_sample(b, wo, rng);
     case MaterialKind::Dielectric: return dielectric_sample(b, wo, rng);
     case MaterialKind::Coated: return coated_sample(b, wo, rng);
-    case MaterialKind::Conductor: return conductor_sample(b, wo, rng);
-    case MaterialKind::Glass: return glass_sample(b, wo, rng);
-    case MaterialKind::Plastic: return plastic_sample(b, wo, rng);
+    case MaterialKind::Conductor:
+      if constexpr (Microfacet) return conductor_sample(b, wo, rng);
+      break;
+    case MaterialKind::Glass:
+      if constexpr (Microfacet) return glass_sample(b, wo, rng);
+      break;
+    case MaterialKind::Plastic:
+      if constexpr (Microfacet) return plastic_sample(b, wo, rng);
+      break;
     case MaterialKind::Emissive: break;
   }
   return no_sample();
 }
 
 // f cos for wi, and (in `pdf`) the density sample_bsdf draws it with.
+template <bool Microfacet = true>
 WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   pdf = 0.0f;
   vec3 f(0.0f);
@@ -74,11 +84,17 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
       f = coated_eval(b, wo, wi);
       break;
     case MaterialKind::Conductor:
-      pdf = conductor_pdf(b, wo, wi);
-      f = conductor_eval(b, wo, wi);
+      if constexpr (Microfacet) {
+        pdf = conductor_pdf(b, wo, wi);
+        f = conductor_eval(b, wo, wi);
+      }
       break;
-    case MaterialKind::Glass: f = glass_eval(b, wo, wi, pdf); break;
-    case MaterialKind::Plastic: f = plastic_eval(b, wo, wi, pdf); break;
+    case MaterialKind::Glass:
+      if constexpr (Microfacet) f = glass_eval(b, wo, wi, pdf);
+      break;
+    case MaterialKind::Plastic:
+      if constexpr (Microfacet) f = plastic_eval(b, wo, wi, pdf);
+      break;
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;
   }
@@ -98,14 +114,15 @@ WT_HD WT_INLINE float pdf_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi) 
 }
 
 // Whether the BSDF has a lobe that is not a delta, which light sampling can reach.
+template <bool Microfacet = true>
 WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
   switch (b.kind) {
     case MaterialKind::Lambertian:
-    case MaterialKind::Coated:
-    case MaterialKind::Plastic: return true;
+    case MaterialKind::Coated: return true;
+    case MaterialKind::Plastic: return Microfacet;
     case MaterialKind::Metal: return b.fuzz > 0.0f;
-    case MaterialKind::Conductor: return !conductor_ggx(b).smooth();
-    case MaterialKind::Glass: return !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();
+    case MaterialKind::Conductor: return Microfacet && !conductor_ggx(b).smooth();
+    case MaterialKind::Glass: return Microfacet && !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;
   }

@@ -66,6 +66,9 @@ WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /
   return (k < static_cast<uint32_t>(MaterialKind::Emissive) ? k : k - 1) * 4u + static_cast<uint32_t>(texture_kind + 1);
 }
 constexpr uint32_t kSortKeyCount = (kMaterialKindCount - 1) * 4 + 1;
+// The microfacet kinds' keys (conductor, glass, plastic: four each, after the
+// study's four kinds), whose shading costs several times a Lambertian's.
+constexpr uint32_t kMicrofacetKeyMask = ((1u << 12) - 1) << ((static_cast<uint32_t>(MaterialKind::Conductor) - 1) * 4);
 constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene sort last
 // The miss key must fit the bits above the slot (path_queue.hpp's 27 leave 5), and a
 // bounce's keys below it are gathered as the bits of one word.

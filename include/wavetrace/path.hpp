@@ -11,8 +11,8 @@ namespace wt {
 constexpr float kRayTMax = 3.0e38f;
 
 // What the path functions are compiled for unless a kernel says otherwise: every
-// primitive kind, and light sampling.
-constexpr uint32_t kEverything = kAllKinds | kLightSampling;
+// primitive kind, light sampling and the microfacet BSDFs.
+constexpr uint32_t kEverything = kAllKinds | kLightSampling | kMicrofacet;
 
 // Kinds: the primitive kinds the scene holds (geometry.hpp), or a superset.
 template <uint32_t Kinds = kAllKinds, class Scene>
@@ -82,7 +82,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
   if (!(pick > 0.0f)) return out;
   const float u1 = rng.uniform(WT_MUTANT(DimensionReused) ? kDimLightPick : kDimLightA), u2 = rng.uniform(kDimLightB);
   const vec3 outward = sp.front ? sp.ng : -sp.ng;
-  const bool either_side = bsdf_transmits(bsdf);
+  const bool either_side = (Kinds & kMicrofacet) != 0 && bsdf_transmits(bsdf);
   vec3 emitted;
   float drawn_pdf;  // the density the direction was drawn with, times the picking probability
   float light_pdf;  // light_density's (or sky_light_density's) for it, for the MIS weight
@@ -114,7 +114,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
     light_pdf = light_density(scene, emitted, shape, out.ray.origin, out.ray.dir, length);
   }
   float bsdf_pdf;
-  vec3 f_cos = eval_bsdf(bsdf, wo, out.ray.dir, bsdf_pdf);
+  vec3 f_cos = eval_bsdf<(Kinds & kMicrofacet) != 0>(bsdf, wo, out.ray.dir, bsdf_pdf);
   if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
   if (WT_MUTANT(MissingCosine)) f_cos *= 1.0f / fmaxf(fabsf(glm::dot(out.ray.dir, bsdf.facing_n())), 1e-3f);
   out.contribution = throughput * f_cos * emitted * (power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
@@ -148,13 +148,14 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const vec3 wo = -ray.dir;
   const BsdfAt bsdf = bsdf_at(m, scene.material_param_array(), scene.bsdf_table_array(), sp,
                               material_albedo(m, scene.texture_array(), scene.image_array(), sp));
+  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
-  if (nee && bsdf_samples_lights(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
+  if (nee && bsdf_samples_lights<kFacets>(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
     shadow = sample_light<Kinds>(scene, bsdf, sp, wo, throughput, rng);
   }
-  const BsdfSample s = sample_bsdf(bsdf, wo, rng);
+  const BsdfSample s = sample_bsdf<kFacets>(bsdf, wo, rng);
   if (s.lobe == 0u) return false;
   const Ray next = spawn_ray(sp, s.wi);
   // The density of the direction the path goes on in, for the MIS weight of what it

@@ -96,6 +96,9 @@ struct Scene {
   Summary summary() const;
   // The primitive kinds the scene places (geometry.hpp's bits).
   uint32_t primitive_kinds() const;
+  // The primitive kinds, and kMicrofacet where a material is a microfacet kind: the
+  // kernel the scene needs (geometry.hpp's with_kinds).
+  uint32_t kernel_kinds() const;
   // What the scene's arrays and images take on the device.
   size_t device_bytes() const;
 

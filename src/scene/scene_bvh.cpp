@@ -302,6 +302,16 @@ uint32_t Scene::primitive_kinds() const {
   return kinds;
 }
 
+uint32_t Scene::kernel_kinds() const {
+  uint32_t kinds = primitive_kinds();
+  for (const Material& m : materials) {
+    if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic) {
+      kinds |= kMicrofacet;
+    }
+  }
+  return kinds;
+}
+
 Scene::Summary Scene::summary() const {
   Summary s;
   s.spheres = spheres.size();

@@ -161,7 +161,7 @@ SceneScalars scene_scalars(const Scene& scene, int width, int height, const Piec
   v.light_power = scene.light_power;
   v.sky_pick = scene.sky_pick;
   v.environment = environment;
-  v.kinds = scene.primitive_kinds();
+  v.kinds = scene.kernel_kinds();
   v.sky = scene.sky;
   v.camera = Camera::make(scene.camera, width, height);
   return v;
