@@ -109,6 +109,39 @@ TEST(MaterialScene, BadFieldsNameTheFieldAndSayWhy) {
   }
 }
 
+// Image textures' transform and wrap, as read; their errors.
+TEST(MaterialScene, ImageTexturesReadTheirTransformAndWrap) {
+  const std::string source = test::repo_path("scenes/wrap-test.json");
+  auto scene = [](const std::string& texture) {
+    return R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]},
+      "textures": [)" + texture + R"(],
+      "materials": [{"name": "m", "type": "lambertian", "texture": "t"}],
+      "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})";
+  };
+  const Scene s = parse_scene(scene(R"({"name": "t", "type": "image", "file": "textures/planet.png",
+      "uv_scale": [2, 3], "uv_offset": [0.5, 0.25], "uv_rotation": 1.5707963, "wrap": ["mirror", "repeat"]})"),
+                              source);
+  const Texture& t = s.textures.at(0);
+  EXPECT_EQ(t.uv_scale, vec2(2.0f, 3.0f));
+  EXPECT_EQ(t.uv_offset, vec2(0.5f, 0.25f));
+  EXPECT_NEAR(t.uv_cos, 0.0f, 1e-6f);
+  EXPECT_NEAR(t.uv_sin, 1.0f, 1e-6f);
+  EXPECT_EQ(t.wrap_u, Wrap::Mirror);
+  EXPECT_EQ(t.wrap_v, Wrap::Repeat);
+  const Scene d = parse_scene(scene(R"({"name": "t", "type": "image", "file": "textures/planet.png"})"), source);
+  EXPECT_EQ(d.textures.at(0).wrap_u, Wrap::Repeat) << "the default: u repeats";
+  EXPECT_EQ(d.textures.at(0).wrap_v, Wrap::Clamp) << "and v clamps";
+  for (const char* bad : {R"("wrap": "tile")", R"("wrap": ["clamp"])", R"("uv_scale": [1])", R"("uv_rotation": "90")"}) {
+    try {
+      parse_scene(scene(std::string(R"({"name": "t", "type": "image", "file": "textures/planet.png", )") + bad + "}"),
+                  source);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("/textures/0/"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // A camera that sees only the sphere, under a uniform sky of radiance 1: a
 // dielectric that loses nothing returns the sky in every pixel. Depth 64 and no
 // roulette (paths inside the glass bounce many times). Per seed 16 x 16 pixels at

@@ -105,7 +105,12 @@ TEST(Material, LambertianScattersCosineDistributedIntoTheFacingHemisphere) {
 }
 
 TEST(Material, TexturedAlbedoIsAlbedoTimesTexture) {
-  const Texture tex[] = {Texture{TextureKind::Checker, -1, 1.0f, 0, vec3(0.9f, 0.8f, 0.7f), vec3(0.1f, 0.2f, 0.3f)}};
+  Texture checker = image_texture(-1, Wrap::Repeat, Wrap::Clamp);
+  checker.kind = TextureKind::Checker;
+  checker.scale = 1.0f;
+  checker.a = vec3(0.9f, 0.8f, 0.7f);
+  checker.b = vec3(0.1f, 0.2f, 0.3f);
+  const Texture tex[] = {checker};
   for (MaterialKind kind : {MaterialKind::Lambertian, MaterialKind::Metal}) {
     const Material m = make_material(kind, vec3(0.5f, 1.0f, 0.25f), 0.0f, 1.5f, 0);
     SurfacePoint sp = top_hit(true);

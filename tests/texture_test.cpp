@@ -1,6 +1,6 @@
 // Textures: the checker parity rule of docs/scene-format.md, the spherical (u, v)
-// mapping, bilinear image lookup with u wrapping and v clamping, and the gradient
-// noise behind the marble texture.
+// mapping, bilinear image lookup with its wrap modes and UV transform, and the
+// gradient noise behind the marble texture.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +15,14 @@ namespace {
 const vec3 kEven(0.9f, 0.8f, 0.7f);
 const vec3 kOdd(0.1f, 0.2f, 0.3f);
 
-Texture checker(float size) { return Texture{TextureKind::Checker, -1, size, 0, kEven, kOdd}; }
+Texture checker(float size) {
+  Texture t = image_texture(-1, Wrap::Repeat, Wrap::Clamp);
+  t.kind = TextureKind::Checker;
+  t.scale = size;
+  t.a = kEven;
+  t.b = kOdd;
+  return t;
+}
 
 // A sphere's surface point: local position and normal, UVs from the normal.
 SurfacePoint sphere_point(const vec3& local, const vec3& n) {
@@ -159,11 +166,64 @@ TEST(Texture, SampleImageWrapsUAndClampsV) {
   }
 }
 
+// The wrap modes on texel indices: repeat by whole periods, clamp to the edge,
+// mirror reflects about each edge (period 2n: ..., 1, 0 | 0, 1, ..., n-1 | n-1, ...).
+TEST(Texture, WrapIndicesRepeatClampAndMirror) {
+  EXPECT_EQ(wrap_index(-1, 4, Wrap::Repeat), 3);
+  EXPECT_EQ(wrap_index(4, 4, Wrap::Repeat), 0);
+  EXPECT_EQ(wrap_index(-1, 4, Wrap::Clamp), 0);
+  EXPECT_EQ(wrap_index(4, 4, Wrap::Clamp), 3);
+  const int mirrored[] = {2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0, 1};  // i = -3 .. 9
+  for (int i = -3; i <= 9; ++i) EXPECT_EQ(wrap_index(i, 4, Wrap::Mirror), mirrored[i + 3]) << i;
+}
+
+// Coordinates outside [0, 1] by mode, on the 4 x 2 image: u = 1.375 is column 1
+// repeated, column 3 clamped (past the last centre), column 2 mirrored (the
+// reflection of u = 0.625 about 1).
+TEST(Texture, SampleImageWrapsByItsModes) {
+  TinyImage im;
+  EXPECT_EQ(sample_image(im.view, 1.375f, 0.25f, Wrap::Repeat, Wrap::Clamp), im.texel(1, 0));
+  EXPECT_EQ(sample_image(im.view, 1.375f, 0.25f, Wrap::Clamp, Wrap::Clamp), im.texel(3, 0));
+  EXPECT_EQ(sample_image(im.view, 1.375f, 0.25f, Wrap::Mirror, Wrap::Clamp), im.texel(2, 0));
+  EXPECT_EQ(sample_image(im.view, -0.375f, 0.25f, Wrap::Mirror, Wrap::Clamp), im.texel(1, 0));
+  // v repeating: v = 1.25 is row 0 again; mirrored, row 1.
+  EXPECT_EQ(sample_image(im.view, 0.375f, 1.25f, Wrap::Repeat, Wrap::Repeat), im.texel(1, 0));
+  EXPECT_EQ(sample_image(im.view, 0.375f, 1.25f, Wrap::Repeat, Wrap::Mirror), im.texel(1, 1));
+  // At a mirrored edge the two taps are the same texel: no blend with the far side.
+  EXPECT_EQ(sample_image(im.view, 0.0f, 0.25f, Wrap::Mirror, Wrap::Clamp), im.texel(0, 0));
+}
+
+// The UV transform (KHR_texture_transform's order: scale, rotate, offset) applied
+// before the lookup, on a mesh point's UVs.
+TEST(Texture, UvTransformScalesRotatesAndOffsets) {
+  TinyImage im;
+  const ImageView images[] = {im.view};
+  SurfacePoint sp{};
+  sp.has_uv = true;
+  auto at = [&](const Texture& t, float u, float v) {
+    sp.uv = vec2(u, v);
+    return eval_texture(t, images, sp);
+  };
+  const Texture plain = image_texture(0, Wrap::Repeat, Wrap::Repeat);
+  Texture scaled = plain;
+  scaled.uv_scale = vec2(2.0f, 0.5f);
+  EXPECT_EQ(at(scaled, 0.1875f, 0.5f), at(plain, 0.375f, 0.25f));
+  Texture shifted = plain;
+  shifted.uv_offset = vec2(0.25f, 0.5f);
+  EXPECT_EQ(at(shifted, 0.125f, 0.25f), at(plain, 0.375f, 0.75f));
+  // A quarter turn: (u, v) -> (v, -u).
+  Texture turned = plain;
+  turned.uv_cos = std::cos(0.5f * 3.14159265f);
+  turned.uv_sin = std::sin(0.5f * 3.14159265f);
+  const vec3 got = at(turned, 0.25f, 0.375f), want = at(plain, 0.375f, -0.25f);
+  EXPECT_NEAR(glm::length(got - want), 0.0f, 1e-4f);
+}
+
 TEST(Texture, ImageTextureIsContinuousAcrossTheSeam) {
   // Through eval_texture: normals just either side of the -x seam read nearly the
   // same colour (u wraps there, so both sides blend the first and last columns).
   TinyImage im;
-  Texture t{TextureKind::Image, 0, 1.0f, 0, vec3(0.0f), vec3(0.0f)};
+  const Texture t = image_texture(0, Wrap::Repeat, Wrap::Clamp);
   const ImageView images[] = {im.view};
   for (float y : {-0.5f, 0.0f, 0.3f}) {
     vec3 a = eval_texture(t, images, sphere_point(vec3(0.0f), glm::normalize(vec3(-1.0f, y, 1e-4f))));
@@ -229,7 +289,11 @@ TEST(Texture, GradientNoiseIsContinuousAcrossCells) {
 
 TEST(Texture, NoiseTextureStaysBetweenItsColoursAndVaries) {
   const vec3 high(1.0f, 0.9f, 0.8f), low(0.1f, 0.2f, 0.05f);
-  Texture t{TextureKind::Noise, -1, 4.0f, 7, high, low};
+  Texture t = checker(4.0f);
+  t.kind = TextureKind::Noise;
+  t.octaves = 7;
+  t.a = high;
+  t.b = low;
   std::mt19937 gen(5);
   std::uniform_real_distribution<float> pos(-1.0f, 1.0f);
   float min_s = 1.0f, max_s = 0.0f;

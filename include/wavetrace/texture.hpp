@@ -11,6 +11,9 @@ namespace wt {
 
 enum class TextureKind : uint32_t { Checker = 0, Noise = 1, Image = 2 };
 
+// How an image texture's coordinates outside [0, 1] fall on it, per axis.
+enum class Wrap : uint32_t { Repeat = 0, Clamp = 1, Mirror = 2 };
+
 struct Texture {
   TextureKind kind;
   int32_t image;  // index into the scene's images (Image only)
@@ -18,7 +21,51 @@ struct Texture {
   int32_t octaves;
   vec3 a;  // Checker: colour of even squares; Noise: the colour at 1
   vec3 b;  // Checker: colour of odd squares;  Noise: the colour at 0
+  // Image: the UV transform (scale, then rotation, then offset, as glTF's
+  // KHR_texture_transform: uv' = offset + R(rotation) (scale * uv)) and the wrap of u and v.
+  vec2 uv_offset;
+  vec2 uv_scale;
+  float uv_cos, uv_sin;  // of the rotation
+  Wrap wrap_u, wrap_v;
 };
+
+// An image texture of image `image`, untransformed, wrapping u and v as given.
+inline Texture image_texture(int32_t image, Wrap wrap_u, Wrap wrap_v) {
+  Texture t{};
+  t.kind = TextureKind::Image;
+  t.image = image;
+  t.uv_scale = vec2(1.0f);
+  t.uv_cos = 1.0f;
+  t.wrap_u = wrap_u;
+  t.wrap_v = wrap_v;
+  return t;
+}
+
+// A texel index along an axis of n texels, by the wrap mode.
+WT_HD WT_INLINE int wrap_index(int i, int n, Wrap w) {
+  switch (w) {
+    case Wrap::Repeat: return i < 0 ? i + n : (i >= n ? i - n : i);
+    case Wrap::Clamp: return i < 0 ? 0 : (i >= n ? n - 1 : i);
+    case Wrap::Mirror: {
+      const int m = i < 0 ? -1 - i : i;  // reflected about the edge: -1 -> 0
+      const int period = m % (2 * n);
+      return period < n ? period : 2 * n - 1 - period;
+    }
+  }
+  return 0;
+}
+
+// The coordinate reduced before it is scaled to texels: repeat keeps its fraction
+// (so large coordinates keep their precision), clamp clamps it to [0, 1], mirror
+// reduces it modulo 2.
+WT_HD WT_INLINE float wrap_coordinate(float u, Wrap w) {
+  switch (w) {
+    case Wrap::Repeat: return u - floorf(u);
+    case Wrap::Clamp: return fminf(fmaxf(u, 0.0f), 1.0f);
+    case Wrap::Mirror: return u - 2.0f * floorf(0.5f * u);
+  }
+  return u;
+}
 
 // One image: a float RGBA texel array in linear colour. `object` is the CUDA texture
 // object (point sampling, unnormalised coordinates) on the GPU; `texels` the host copy.
@@ -38,18 +85,20 @@ WT_HD WT_INLINE vec3 image_texel(const ImageView& im, int x, int y) {
 #endif
 }
 
-// Bilinear lookup: u wraps, v clamps (texel centres at half-integers).
-WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v) {
-  float x = (u - floorf(u)) * im.width - 0.5f;
-  float y = fminf(fmaxf(v, 0.0f), 1.0f) * im.height - 0.5f;
+// Bilinear lookup (texel centres at half-integers), u and v wrapped by their modes
+// (by default u repeats and v clamps, the spheres' mapping).
+WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v, Wrap wrap_u = Wrap::Repeat,
+                                  Wrap wrap_v = Wrap::Clamp) {
+  float x = wrap_coordinate(u, wrap_u) * im.width - 0.5f;
+  float y = wrap_coordinate(v, wrap_v) * im.height - 0.5f;
   float fx = floorf(x), fy = floorf(y);
   float ax = x - fx, ay = y - fy;
   int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   int x1 = x0 + 1, y1 = y0 + 1;
-  x0 = x0 < 0 ? x0 + im.width : x0;
-  x1 = x1 >= im.width ? x1 - im.width : x1;
-  y0 = y0 < 0 ? 0 : y0;
-  y1 = y1 >= im.height ? im.height - 1 : y1;
+  x0 = wrap_index(x0, im.width, wrap_u);
+  x1 = wrap_index(x1, im.width, wrap_u);
+  y0 = wrap_index(y0, im.height, wrap_v);
+  y1 = wrap_index(y1, im.height, wrap_v);
   vec3 top = (1.0f - ax) * image_texel(im, x0, y0) + ax * image_texel(im, x1, y0);
   vec3 bottom = (1.0f - ax) * image_texel(im, x0, y1) + ax * image_texel(im, x1, y1);
   return (1.0f - ay) * top + ay * bottom;
@@ -118,7 +167,9 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
     case TextureKind::Image: {
       vec2 uv = sp.has_uv ? sp.uv : sphere_uv(sp.n);
       if (WT_MUTANT(TextureVFlipped)) uv.y = 1.0f - uv.y;
-      return sample_image(images[t.image], uv.x, uv.y);
+      const vec2 s = uv * t.uv_scale;
+      uv = t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
+      return sample_image(images[t.image], uv.x, uv.y, t.wrap_u, t.wrap_v);
     }
   }
   return vec3(0.0f);

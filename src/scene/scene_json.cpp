@@ -58,6 +58,14 @@ vec3 SceneReader::triple(const json& j, const JsonPath& path) const {
   return vec3(number(j[0], path / 0), number(j[1], path / 1), number(j[2], path / 2));
 }
 
+vec2 SceneReader::pair(const json& j, const JsonPath& path) const {
+  if (!j.is_array() || j.size() != 2) {
+    fail_at(path, "must be an array of 2 numbers (got " +
+                    (j.is_array() ? std::to_string(j.size()) + " elements" : std::string(j.type_name())) + ")");
+  }
+  return vec2(number(j[0], path / 0), number(j[1], path / 1));
+}
+
 vec3 SceneReader::colour(const json& j, const JsonPath& path) const {
   vec3 c = triple(j, path);
   for (size_t i = 0; i < 3; ++i) unit_interval(j[i], path / i);

@@ -82,9 +82,8 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
       const MeshMaterial& mm = mesh.materials[i];
       Material m = mm.material;
       if (!mm.albedo_map.empty()) {
-        Texture t{};
-        t.kind = TextureKind::Image;
-        t.image = image_file(mm.albedo_map, true, mesh.source);
+        // Both axes repeat, as glTF's default sampler and OBJ's maps do.
+        const Texture t = image_texture(image_file(mm.albedo_map, true, mesh.source), Wrap::Repeat, Wrap::Repeat);
         m.texture = static_cast<int32_t>(scene_.textures.size());
         m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, static_cast<int>(TextureKind::Image)));
         scene_.textures.push_back(t);

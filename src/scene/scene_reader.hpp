@@ -40,6 +40,7 @@ class SceneReader : JsonReader {
   // Field readers shared by the sections (scene_json.cpp).
   const std::string& name(const json& obj, const JsonPath& path) const;
   vec3 triple(const json& j, const JsonPath& path) const;
+  vec2 pair(const json& j, const JsonPath& path) const;
   vec3 colour(const json& j, const JsonPath& path) const;
   // Each component in [0, kMaxRadiance].
   vec3 radiance(const json& j, const JsonPath& path) const;

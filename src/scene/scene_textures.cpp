@@ -25,8 +25,9 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
   object(j, path);
   remember(texture_names_, name(j, path), scene_.textures.size(), "texture", path);
   size_t type = type_of(j, path, "texture", {"checker", "noise", "image"});
-  Texture t{};
-  t.image = -1;
+  // Image textures' defaults: untransformed, u repeating and v clamped (the
+  // spheres' mapping runs v pole to pole).
+  Texture t = image_texture(-1, Wrap::Repeat, Wrap::Clamp);
   if (type == 0) {
     check_keys(j, path, {"name", "type", "size", "even", "odd"}, "checker");
     t.kind = TextureKind::Checker;
@@ -41,8 +42,27 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
     t.a = colour(required(j, path, "high"), path / "high");
     t.b = colour(required(j, path, "low"), path / "low");
   } else {
-    check_keys(j, path, {"name", "type", "file", "colorspace"}, "image");
+    check_keys(j, path, {"name", "type", "file", "colorspace", "uv_offset", "uv_scale", "uv_rotation", "wrap"},
+               "image");
     t.kind = TextureKind::Image;
+    if (j.contains("uv_offset")) t.uv_offset = pair(j["uv_offset"], path / "uv_offset");
+    if (j.contains("uv_scale")) t.uv_scale = pair(j["uv_scale"], path / "uv_scale");
+    if (j.contains("uv_rotation")) {
+      const float r = number(j["uv_rotation"], path / "uv_rotation");
+      t.uv_cos = std::cos(r);
+      t.uv_sin = std::sin(r);
+    }
+    if (j.contains("wrap")) {
+      static const std::vector<std::string> kWraps = {"repeat", "clamp", "mirror"};
+      const json& w = j["wrap"];
+      if (w.is_string()) {
+        t.wrap_u = t.wrap_v = static_cast<Wrap>(choice(w, path / "wrap", kWraps));
+      } else {
+        if (!w.is_array() || w.size() != 2) fail_at(path / "wrap", "must be a wrap mode or a pair of them [u, v]");
+        t.wrap_u = static_cast<Wrap>(choice(w[0], path / "wrap" / size_t{0}, kWraps));
+        t.wrap_v = static_cast<Wrap>(choice(w[1], path / "wrap" / size_t{1}, kWraps));
+      }
+    }
     bool srgb = true;
     if (j.contains("colorspace")) {
       std::string cs = string(j["colorspace"], path / "colorspace");
