@@ -2,11 +2,11 @@
 // (GGX). The coat reflects F D G / (4 mu_o) (a mirror with F when smooth); what it
 // lets through reaches the base, bounces between base and coat, and leaves:
 //   f_d cos = albedo / (1 - albedo R_int) / ior^2 t(mu_o) t(mu_i) mu_i / pi,
-// with t(mu) the coat's transmittance from outside (1 - F(mu) when smooth, 1 minus
-// the rough coat's directional albedo otherwise: a table per material) and R_int
-// the coat's diffuse reflectance from inside, summing the internal bounces as a
-// geometric series. This is the model of Mitsuba 3's plastic and roughplastic with
-// `nonlinear` set. Two-sided.
+// with t(mu) the coat's transmittance from outside (1 - F(mu) when smooth; when
+// rough, what its single-scattering BTDF carries through, the masking's losses
+// lost: a table per material) and R_int the coat's diffuse reflectance from inside,
+// summing the internal bounces as a geometric series. This is the model of Mitsuba
+// 3's plastic and roughplastic with `nonlinear` set. Two-sided.
 #pragma once
 
 #include "wavetrace/bsdfs/common.hpp"
