@@ -40,7 +40,7 @@ Material make_material(MaterialKind kind, vec3 albedo, float fuzz = 0.0f, float 
 bool scatter(const Material& m, const Texture* textures, const ImageView* images, const Ray& in,
              const SurfacePoint& sp, const Rng& rng, vec3& attenuation, Ray& next) {
   if (m.kind == MaterialKind::Emissive) return false;
-  const BsdfAt b = bsdf_at(m, nullptr, nullptr, sp, material_albedo(m, textures, images, sp));
+  const BsdfAt b = bsdf_at(m, BsdfInputs{}, sp, material_albedo(m, textures, images, sp), -in.dir);
   const BsdfSample s = sample_bsdf(b, -in.dir, rng);
   if (s.lobe == 0u) return false;
   attenuation = s.weight;

@@ -185,7 +185,7 @@ TEST(MetalDensity, FuzzyDirectionIsScatterMetals) {
     for (int i = 0; i < 2000; ++i) {
       const Rng rng = Rng::at(21, uint32_t(i), 0, 0);
       vec3 dir;
-      const BsdfSample s = metal_sample(bsdf_at(m, nullptr, nullptr, sp, m.albedo), -in.dir, rng);
+      const BsdfSample s = metal_sample(bsdf_at(m, BsdfInputs{}, sp, m.albedo, -in.dir), -in.dir, rng);
       if (s.lobe == 0u) continue;
       ++kept;
       ASSERT_TRUE(fuzzy_direction(r, fuzz, rng, dir));

@@ -19,26 +19,54 @@
 
 namespace wt {
 
-// The BSDF of material m at sp, its albedo there being `albedo` (material_albedo).
-// `params` and `tables`: the scene's material_params and bsdf_tables.
-WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const MaterialParams* params, const float* tables,
-                               const SurfacePoint& sp, const vec3& albedo) {
+// What bsdf_at reads of the scene: its material_params, bsdf_tables, textures and
+// images.
+struct BsdfInputs {
+  const MaterialParams* params;
+  const float* tables;
+  const Texture* textures;
+  const ImageView* images;
+};
+
+// The BSDF of material m at sp seen from wo, its albedo there being `albedo`
+// (material_albedo). Where the material has parameters beyond the study's
+// (Microfacet kernels only): its textured roughness and normal map are looked up,
+// and the shading normal is turned to face wo (facing_viewer).
+template <bool Microfacet = true>
+WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const SurfacePoint& sp, const vec3& albedo,
+                               const vec3& wo) {
   BsdfAt b;
   b.kind = m.kind;
   b.flags = m.flags;
   b.fuzz = m.fuzz;
   b.ior = m.ior;
   b.albedo = albedo;
-  if (m.params >= 0) {
-    b.p = params[m.params];
-  } else {
-    b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f)};
-  }
   b.n = sp.n;
   b.ng = sp.ng;
   b.dpdu = sp.dpdu;
   b.front = sp.front;
-  b.tables = tables;
+  b.tables = in.tables;
+  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f};
+  if constexpr (Microfacet) {
+    if (m.params >= 0) {
+      b.p = in.params[m.params];
+      if (b.p.roughness_texture >= 0) {
+        // Roughness scales by the texture's green channel, alpha by its square.
+        const float r = fminf(fmaxf(eval_texture(in.textures[b.p.roughness_texture], in.images, sp).y, 0.0f), 1.0f);
+        b.p.ax *= r * r;
+        b.p.ay *= r * r;
+        if (b.kind == MaterialKind::Plastic && b.p.table >= 0 && b.p.table_rows > 1) {
+          b.p.internal = cosine_table(in.tables + b.p.table + b.p.table_rows * kEnergySize,
+                                      table_roughness(Ggx{b.p.ax, b.p.ay}));
+        }
+      }
+      if (b.p.normal_texture >= 0) {
+        b.n = mapped_normal(sp.n, sp.dpdu, sp.tangent_sign,
+                            eval_texture(in.textures[b.p.normal_texture], in.images, sp), b.p.normal_strength);
+      }
+      b.n = facing_viewer(b.n, wo, b.front);
+    }
+  }
   return b;
 }
 

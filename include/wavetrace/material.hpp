@@ -28,15 +28,20 @@ enum MaterialFlag : uint16_t {
   kMaterialSeparable = 8,    // Conductor, Glass, Plastic: separable Smith masking (Ggx::separable)
 };
 
-// The parameters of the microfacet kinds (conductor, glass, plastic), one per such
-// material, in the scene's material_params (Material::params indexes it).
+// The parameters beyond the study's: the microfacet kinds' (conductor, glass,
+// plastic) and any kind's normal map; one per such material, in the scene's
+// material_params (Material::params indexes it).
 struct MaterialParams {
   float ax, ay;     // GGX alphas along the tangent and across it (below kSmoothAlpha: smooth)
   float internal;   // Plastic: the coat's diffuse reflectance seen from inside
   int32_t table;    // the offset of the material's tables in the scene's bsdf_tables (-1: none)
   vec3 eta;         // Conductor: the real part of the index (or f0 with kMaterialSchlick)
   vec3 k;           // Conductor: the imaginary part
-  vec3 multiple;    // Conductor with kMaterialCompensated: Kulla-Conty's scale of the multiple-scattering lobe
+  vec3 fresnel_average;  // Conductor: 2 int F(mu) mu dmu per channel (Kulla-Conty's F_avg)
+  int32_t table_rows;         // 1, or kEnergySize rows by roughness where the roughness is textured
+  int32_t roughness_texture;  // -1, or the texture whose green channel scales the roughness
+  int32_t normal_texture;     // -1, or a tangent-space normal map (linear colour)
+  float normal_strength;      // scales the normal map's x and y (glTF's normalTexture.scale)
 };
 
 // Kept at 44 bytes: the constant-memory megakernel holds every material of a

@@ -146,9 +146,10 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 wo = -ray.dir;
-  const BsdfAt bsdf = bsdf_at(m, scene.material_param_array(), scene.bsdf_table_array(), sp,
-                              material_albedo(m, scene.texture_array(), scene.image_array(), sp));
   constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
+  const BsdfAt bsdf = bsdf_at<kFacets>(
+      m, BsdfInputs{scene.material_param_array(), scene.bsdf_table_array(), scene.texture_array(), scene.image_array()},
+      sp, material_albedo(m, scene.texture_array(), scene.image_array(), sp), wo);
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.

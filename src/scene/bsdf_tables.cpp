@@ -130,11 +130,6 @@ const std::vector<float>& conductor_energy_table(bool separable) {
   return separable ? uncorrelated : correlated;
 }
 
-float conductor_multiple_scale(float f_avg, float e_avg) {
-  if (!(1.0f - e_avg > 1e-5f)) return 0.0f;
-  return f_avg * f_avg * e_avg / ((1.0f - e_avg) * (1.0f - f_avg * (1.0f - e_avg)));
-}
-
 vec3 conductor_average_fresnel(const vec3& eta, const vec3& k, bool schlick) {
   vec3 out;
   for (int c = 0; c < 3; ++c) {
@@ -145,24 +140,48 @@ vec3 conductor_average_fresnel(const vec3& eta, const vec3& k, bool schlick) {
   return out;
 }
 
-std::vector<float> glass_energy_table(float ior, const Ggx& g) {
-  std::vector<float> t(kGlassTableFloats);
+namespace {
+
+// The lobe of table row i: the material's own, or roughness i / (kEnergySize - 1)
+// where the table has a row per roughness.
+Ggx row_ggx(const Ggx& g, int i, int rows) {
+  if (rows <= 1) return g;
+  const float r = static_cast<float>(i) / (kEnergySize - 1);
+  return Ggx{r * r, r * r, g.separable};
+}
+
+}  // namespace
+
+std::vector<float> glass_energy_table(float ior, const Ggx& g, int rows) {
+  std::vector<float> t(2 * rows * kEnergySize);
   for (int side = 0; side < 2; ++side) {
     const float eta = side == 0 ? ior : 1.0f / ior;
-    for (int j = 0; j < kEnergySize; ++j) {
-      t[side * kEnergySize + j] =
-          static_cast<float>(mean_over_normals(g, view_at(grid_cosine(j)), [&](const vec3& wo, const vec3& h) {
-            const float f = fresnel_dielectric(glm::dot(wo, h), eta);
-            return f * reflected_weight(g, wo, h) + (f < 1.0f ? (1.0f - f) * refracted_weight(g, wo, h, eta) : 0.0f);
-          }));
+    for (int i = 0; i < rows; ++i) {
+      const Ggx row = row_ggx(g, i, rows);
+      for (int j = 0; j < kEnergySize; ++j) {
+        t[(side * rows + i) * kEnergySize + j] =
+            row.smooth() ? 1.0f
+                         : static_cast<float>(mean_over_normals(row, view_at(grid_cosine(j)), [&](const vec3& wo, const vec3& h) {
+                             const float f = fresnel_dielectric(glm::dot(wo, h), eta);
+                             return f * reflected_weight(row, wo, h) +
+                                    (f < 1.0f ? (1.0f - f) * refracted_weight(row, wo, h, eta) : 0.0f);
+                           }));
+      }
     }
   }
   return t;
 }
 
-std::vector<float> plastic_transmittance_table(float ior, const Ggx& g) {
-  std::vector<float> t(kPlasticTableFloats);
-  for (int j = 0; j < kEnergySize; ++j) t[j] = coat_transmittance(g, ior, grid_cosine(j));
+std::vector<float> plastic_table(float ior, const Ggx& g, int rows) {
+  std::vector<float> t(rows * kEnergySize + (rows > 1 ? kEnergySize : 0));
+  for (int i = 0; i < rows; ++i) {
+    const Ggx row = row_ggx(g, i, rows);
+    for (int j = 0; j < kEnergySize; ++j) {
+      const float mu = grid_cosine(j);
+      t[i * kEnergySize + j] = row.smooth() ? 1.0f - fresnel_dielectric(mu, ior) : coat_transmittance(row, ior, mu);
+    }
+    if (rows > 1) t[rows * kEnergySize + i] = plastic_internal_reflectance(ior, row);
+  }
   return t;
 }
 
@@ -186,30 +205,31 @@ float plastic_internal_reflectance(float ior, const Ggx& g) {
 void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t* conductor_offsets) {
   const bool separable = (m.flags & kMaterialSeparable) != 0;
   const Ggx g{p.ax, p.ay, separable};
-  const bool compensated = (m.flags & kMaterialCompensated) != 0 && !g.smooth();
+  // A textured roughness can be any below the material's: its tables get a row per roughness.
+  const int rows = p.roughness_texture >= 0 && m.kind != MaterialKind::Conductor ? kEnergySize : 1;
+  p.table_rows = rows;
+  const bool rough = !g.smooth();
+  const bool compensated = (m.flags & kMaterialCompensated) != 0 && rough;
   auto append = [&tables](const std::vector<float>& t) {
     const int32_t at = static_cast<int32_t>(tables.size());
     tables.insert(tables.end(), t.begin(), t.end());
     return at;
   };
   p.table = -1;
-  p.multiple = vec3(0.0f);
+  p.fresnel_average = vec3(0.0f);
   switch (m.kind) {
     case MaterialKind::Conductor:
       if (compensated) {
         if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
         p.table = conductor_offsets[separable];
-        const float e_avg =
-            conductor_average_energy(conductor_energy_table(separable).data(), conductor_table_roughness(g));
-        const vec3 f_avg = conductor_average_fresnel(p.eta, p.k, (m.flags & kMaterialSchlick) != 0);
-        for (int c = 0; c < 3; ++c) p.multiple[c] = conductor_multiple_scale(f_avg[c], e_avg);
+        p.fresnel_average = conductor_average_fresnel(p.eta, p.k, (m.flags & kMaterialSchlick) != 0);
       }
       break;
     case MaterialKind::Glass:
-      if (compensated && !(m.flags & kMaterialThin)) p.table = append(glass_energy_table(m.ior, g));
+      if (compensated && !(m.flags & kMaterialThin)) p.table = append(glass_energy_table(m.ior, g, rows));
       break;
     case MaterialKind::Plastic:
-      if (!g.smooth()) p.table = append(plastic_transmittance_table(m.ior, g));
+      if (rough) p.table = append(plastic_table(m.ior, g, rows));
       p.internal = plastic_internal_reflectance(m.ior, g);
       break;
     default:

@@ -13,19 +13,17 @@ namespace wt {
 // each built once a process.
 const std::vector<float>& conductor_energy_table(bool separable);
 
-// The scalar Kulla-Conty factor for one channel of average Fresnel f_avg at the
-// average albedo e_avg (0 where single scattering loses nothing).
-float conductor_multiple_scale(float f_avg, float e_avg);
-
 // 2 int_0^1 F(mu) mu dmu of a conductor's Fresnel, per channel.
 vec3 conductor_average_fresnel(const vec3& eta, const vec3& k, bool schlick);
 
-// E(mu) of a rough glass from outside, then from inside (kGlassTableFloats).
-std::vector<float> glass_energy_table(float ior, const Ggx& g);
+// E(mu) of a rough glass from outside, then from inside, each `rows` rows: 1 (the
+// material's roughness) or kEnergySize (by roughness).
+std::vector<float> glass_energy_table(float ior, const Ggx& g, int rows);
 
-// The transmittance t(mu) from outside of a rough plastic's coat
-// (kPlasticTableFloats), and the coat's diffuse reflectance from inside.
-std::vector<float> plastic_transmittance_table(float ior, const Ggx& g);
+// The transmittance t(mu) from outside of a rough plastic's coat in `rows` rows as
+// above, then (rows by roughness only) the coat's internal reflectance by roughness;
+// and the internal reflectance of one coat.
+std::vector<float> plastic_table(float ior, const Ggx& g, int rows);
 float plastic_internal_reflectance(float ior, const Ggx& g);
 
 // Fills the material's params for its kind (alphas already set, eta/k or f0 for

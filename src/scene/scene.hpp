@@ -17,6 +17,7 @@ struct Image {
   std::string path;  // as resolved from the scene file
   int width = 0, height = 0;
   std::vector<float> texels;  // RGBA, linear, row 0 = top
+  bool srgb_decoded = false;  // its 8-bit colours went through the sRGB decoding curve
 };
 
 // The bounds of a scene's numbers, refused at load beyond them, so that no product the
@@ -96,8 +97,9 @@ struct Scene {
   Summary summary() const;
   // The primitive kinds the scene places (geometry.hpp's bits).
   uint32_t primitive_kinds() const;
-  // The primitive kinds, and kMicrofacet where a material is a microfacet kind: the
-  // kernel the scene needs (geometry.hpp's with_kinds).
+  // The primitive kinds, and kMicrofacet where a material has parameters beyond the
+  // study's (the microfacet kinds, normal maps): the kernel the scene needs
+  // (geometry.hpp's with_kinds).
   uint32_t kernel_kinds() const;
   // What the scene's arrays and images take on the device.
   size_t device_bytes() const;

@@ -304,10 +304,10 @@ uint32_t Scene::primitive_kinds() const {
 
 uint32_t Scene::kernel_kinds() const {
   uint32_t kinds = primitive_kinds();
+  // The microfacet kinds, and any material with parameters beyond the study's (a
+  // normal map), need the kernels that read them.
   for (const Material& m : materials) {
-    if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic) {
-      kinds |= kMicrofacet;
-    }
+    if (m.params >= 0) kinds |= kMicrofacet;
   }
   return kinds;
 }

@@ -25,14 +25,17 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   static const std::vector<std::string> kTypes = {"lambertian", "metal", "dielectric", "coated",
                                                   "emissive",   "conductor", "glass", "plastic"};
   static const std::vector<std::vector<std::string>> kKeys = {
-      {"name", "type", "albedo", "texture"},
-      {"name", "type", "albedo", "fuzz", "texture"},
-      {"name", "type", "ior", "albedo"},
-      {"name", "type", "albedo", "ior", "texture"},
+      {"name", "type", "albedo", "texture", "normal_texture", "normal_strength"},
+      {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength"},
+      {"name", "type", "ior", "albedo", "normal_texture", "normal_strength"},
+      {"name", "type", "albedo", "ior", "texture", "normal_texture", "normal_strength"},
       {"name", "type", "emission"},
-      {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation", "masking"},
-      {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation", "masking"},
-      {"name", "type", "albedo", "texture", "ior", "roughness", "masking"},
+      {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation", "masking",
+       "roughness_texture", "normal_texture", "normal_strength"},
+      {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation", "masking", "roughness_texture",
+       "normal_texture", "normal_strength"},
+      {"name", "type", "albedo", "texture", "ior", "roughness", "masking", "roughness_texture", "normal_texture",
+       "normal_strength"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -56,26 +59,47 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
     m.albedo = vec3(0.0f);
     m.emission = radiance(required(j, path, "emission"), path / "emission");
   }
-  if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic) {
-    read_microfacet(j, path, m);
-  }
   int texture_kind = -1;
   if (j.contains("texture")) {
-    std::string t = string(j["texture"], path / "texture");
-    auto found = texture_names_.find(t);
-    if (found == texture_names_.end()) fail_at(path / "texture", "unknown texture '" + t + "'");
-    m.texture = static_cast<int32_t>(found->second.first);
+    m.texture = texture_named(j["texture"], path / "texture");
     texture_kind = static_cast<int>(scene_.textures[m.texture].kind);
+  }
+  if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic ||
+      j.contains("normal_texture")) {
+    read_params(j, path, m);
   }
   m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, texture_kind));
   scene_.materials.push_back(m);
   scene_.material_names.push_back(n);
 }
 
-// The microfacet kinds' own fields, into a MaterialParams of their own.
-void SceneReader::read_microfacet(const json& j, const JsonPath& path, Material& m) {
+int32_t SceneReader::texture_named(const json& j, const JsonPath& path) const {
+  const std::string& t = string(j, path);
+  auto found = texture_names_.find(t);
+  if (found == texture_names_.end()) fail_at(path, "unknown texture '" + t + "'");
+  return static_cast<int32_t>(found->second.first);
+}
+
+// The fields beyond the study's (the microfacet kinds', a normal map), into a
+// MaterialParams of the material's own.
+void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) {
   MaterialParams p{};
-  const float roughness = j.contains("roughness") ? unit_interval(j["roughness"], path / "roughness") : 0.0f;
+  p.table_rows = 1;
+  p.roughness_texture = j.contains("roughness_texture") ? texture_named(j["roughness_texture"], path / "roughness_texture") : -1;
+  p.normal_texture = -1;
+  p.normal_strength = 1.0f;
+  if (j.contains("normal_texture")) {
+    p.normal_texture = texture_named(j["normal_texture"], path / "normal_texture");
+    if (scene_.textures[p.normal_texture].kind == TextureKind::Image &&
+        scene_.images[scene_.textures[p.normal_texture].image].srgb_decoded) {
+      fail_at(path / "normal_texture", "a normal map holds vectors, not colours: give its image texture \"colorspace\": \"linear\"");
+    }
+  }
+  if (j.contains("normal_strength")) p.normal_strength = non_negative(j["normal_strength"], path / "normal_strength");
+  // Textured roughness scales the roughness, which then defaults to 1.
+  const float roughness = j.contains("roughness")           ? unit_interval(j["roughness"], path / "roughness")
+                          : p.roughness_texture >= 0 ? 1.0f
+                                                     : 0.0f;
   const float anisotropy = j.contains("anisotropy") ? unit_interval(j["anisotropy"], path / "anisotropy") : 0.0f;
   const Ggx g = ggx_from_roughness(roughness, anisotropy);
   p.ax = g.ax;

@@ -67,7 +67,9 @@ class SceneReader : JsonReader {
 
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);
-  void read_microfacet(const json& j, const JsonPath& path, Material& m);
+  void read_params(const json& j, const JsonPath& path, Material& m);
+  // A texture by name (the field's value); an error names the field.
+  int32_t texture_named(const json& j, const JsonPath& path) const;
 
   // scene_geometry.cpp
   void read_sphere(const json& j, const JsonPath& path);

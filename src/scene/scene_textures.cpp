@@ -323,6 +323,7 @@ int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::strin
                     : ext == ".exr" ? read_exr(resolved, im, why) && check_radiance(im, why)
                                     : read_8bit(resolved, srgb, im, why);
   if (!read) return -1;
+  im.srgb_decoded = srgb && ext != ".hdr" && ext != ".exr";
   texture_seconds_ += seconds_since(start);
 
   int32_t index = static_cast<int32_t>(scene_.images.size());

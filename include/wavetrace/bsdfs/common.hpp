@@ -62,6 +62,34 @@ struct Frame {
 WT_HD WT_INLINE float cos2_theta(const vec3& w) { return w.z * w.z; }
 WT_HD WT_INLINE float sin2_theta(const vec3& w) { return fmaxf(0.0f, w.x * w.x + w.y * w.y); }
 
+// The shading normal a tangent-space normal map gives, from the map's linear colour
+// c: n_t = 2c - 1, its x and y scaled by `strength`, in the frame of the tangent T
+// (dp/du made orthogonal to n), the bitangent B = cross(n, T) times the UV
+// handedness (up the image) and n, the unperturbed shading normal (outward).
+WT_HD WT_INLINE vec3 mapped_normal(const vec3& n, const vec3& dpdu, float tangent_sign, const vec3& c,
+                                   float strength) {
+  const Frame f = Frame::about(n, dpdu);
+  const vec3 t = 2.0f * c - vec3(1.0f);
+  const vec3 m = t.x * strength * f.t + (t.y * strength * tangent_sign) * f.b + t.z * f.n;
+  const float len2 = glm::dot(m, m);
+  return len2 > 1e-12f ? m * (1.0f / sqrtf(len2)) : n;
+}
+
+// A shading normal that faces away from wo on wo's side of the surface (an
+// interpolated or mapped normal can) is turned towards wo, in the plane of the
+// two, until their cosine is kFacingCosine: the BSDF then sees wo above its
+// hemisphere and gives no black pixel, and the reflections it samples that would
+// cross the geometric surface are absorbed there (BsdfAt::same_side), so no light
+// leaks through. `n` outward; `front`: wo on the outward side.
+constexpr float kFacingCosine = 0.01f;
+WT_HD WT_INLINE vec3 facing_viewer(const vec3& n, const vec3& wo, bool front) {
+  const vec3 nf = front ? n : -n;
+  const float c = glm::dot(wo, nf);
+  if (c >= kFacingCosine) return n;
+  const vec3 turned = glm::normalize(nf + (kFacingCosine - c) * wo);
+  return front ? turned : -turned;
+}
+
 // The BSDF at one hit, as every BSDF reads it: the material's values there
 // (textures looked up), the microfacet kinds' parameters, the hit's normals and
 // which side of the surface the path arrives from. Directions are world-space and

@@ -5,8 +5,9 @@
 // "Revisiting physically based shading at Imageworks"):
 //   f_ms cos = multiple (1 - E(mu_o)) (1 - E(mu_i)) mu_i / pi,
 // with E the GGX directional albedo at F = 1 (energy.hpp) and `multiple` =
-// F_avg^2 E_avg / ((1 - E_avg)(1 - F_avg (1 - E_avg))) per channel, so that a white
-// conductor (F = 1) reflects all that reaches it. Two-sided.
+// F_avg^2 E_avg / ((1 - E_avg)(1 - F_avg (1 - E_avg))) per channel (E_avg at the
+// hit's roughness, which a texture may set), so that a white conductor (F = 1)
+// reflects all that reaches it. Two-sided.
 #pragma once
 
 #include "wavetrace/bsdfs/common.hpp"
@@ -19,9 +20,13 @@ WT_HD WT_INLINE vec3 conductor_fresnel(const BsdfAt& b, float cos_i) {
   return (b.flags & kMaterialSchlick) ? schlick_f0(cos_i, b.p.eta) : fresnel_conductor(cos_i, b.p.eta, b.p.k);
 }
 
-// The roughness the energy table is read at: that of the isotropic lobe of equal
-// alpha_x alpha_y.
-WT_HD WT_INLINE float conductor_table_roughness(const Ggx& g) { return sqrtf(sqrtf(g.ax * g.ay)); }
+// Kulla-Conty's scale of the multiple-scattering lobe, per channel, for the average
+// Fresnel f_avg at the average albedo e_avg (0 where single scattering loses nothing).
+WT_HD WT_INLINE vec3 conductor_multiple_scale(const vec3& f_avg, float e_avg) {
+  const float lost = 1.0f - e_avg;
+  if (!(lost > 1e-5f)) return vec3(0.0f);
+  return f_avg * f_avg * e_avg / (lost * (vec3(1.0f) - f_avg * lost));
+}
 
 WT_HD WT_INLINE bool conductor_compensated(const BsdfAt& b) {
   return (b.flags & kMaterialCompensated) != 0 && b.p.table >= 0;
@@ -31,7 +36,7 @@ WT_HD WT_INLINE bool conductor_compensated(const BsdfAt& b) {
 // scattering misses at mu_o.
 WT_HD WT_INLINE float conductor_multiple_share(const BsdfAt& b, const Ggx& g, float mu_o) {
   if (!conductor_compensated(b)) return 0.0f;
-  return 1.0f - conductor_energy(b.tables + b.p.table, conductor_table_roughness(g), mu_o);
+  return 1.0f - conductor_energy(b.tables + b.p.table, table_roughness(g), mu_o);
 }
 
 // Local frame (z = the facing shading normal); wo.z > 0.
@@ -41,8 +46,9 @@ WT_HD WT_INLINE vec3 conductor_eval_local(const BsdfAt& b, const Ggx& g, const v
   vec3 f = conductor_fresnel(b, glm::dot(wo, h)) * (g.d(h) * g.g2(wo, wi) / (4.0f * wo.z));
   if (conductor_compensated(b)) {
     const float* t = b.tables + b.p.table;
-    const float r = conductor_table_roughness(g);
-    f += b.p.multiple * ((1.0f - conductor_energy(t, r, wo.z)) * (1.0f - conductor_energy(t, r, wi.z)) * wi.z / kPi);
+    const float r = table_roughness(g);
+    f += conductor_multiple_scale(b.p.fresnel_average, conductor_average_energy(t, r)) *
+         ((1.0f - conductor_energy(t, r, wo.z)) * (1.0f - conductor_energy(t, r, wi.z)) * wi.z / kPi);
   }
   return f;
 }
@@ -54,7 +60,7 @@ WT_HD WT_INLINE float conductor_pdf_local(const BsdfAt& b, const Ggx& g, const v
   const float single = g.visible_d(wo, h) / (4.0f * glm::dot(wo, h));
   if (!(q > 0.0f)) return single;
   const float multiple =
-      conductor_multiple_density(b.tables + b.p.table, conductor_table_roughness(g), wi.z) * (0.5f / kPi);
+      conductor_multiple_density(b.tables + b.p.table, table_roughness(g), wi.z) * (0.5f / kPi);
   return (1.0f - q) * single + q * multiple;
 }
 
@@ -74,7 +80,7 @@ WT_HD WT_INLINE BsdfSample conductor_sample(const BsdfAt& b, const vec3& wo_worl
   if (rng.uniform(kDimLayer) < conductor_multiple_share(b, g, wo.z)) {
     // The multiple-scattering lobe, by its shape in mu_i (energy.hpp) and uniform in azimuth.
     float density;
-    const float mu = conductor_multiple_cosine(b.tables + b.p.table, conductor_table_roughness(g),
+    const float mu = conductor_multiple_cosine(b.tables + b.p.table, table_roughness(g),
                                                rng.uniform(kDimScatterA), density);
     const float sin_t = sqrtf(fmaxf(0.0f, 1.0f - mu * mu)), phi = 2.0f * kPi * rng.uniform(kDimScatterB);
     wi = vec3(sin_t * cosf(phi), sin_t * sinf(phi), mu);

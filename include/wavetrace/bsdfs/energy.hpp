@@ -17,10 +17,10 @@ constexpr int kConductorAverage = kEnergySize * kEnergySize;
 constexpr int kConductorCdf = kConductorAverage + kEnergySize;
 constexpr int kConductorTableFloats = kConductorCdf + kEnergySize * (kEnergySize + 1);
 // A rough glass's: E(mu) from outside, then from inside (reflection plus
-// transmission, before the radiance scaling and the tint).
-constexpr int kGlassTableFloats = 2 * kEnergySize;
-// A rough plastic's: the coat's transmittance 1 - E_spec(mu) from outside.
-constexpr int kPlasticTableFloats = kEnergySize;
+// transmission, before the radiance scaling and the tint), each one row, or a row
+// per roughness where the roughness is textured (MaterialParams::table_rows).
+// A rough plastic's: the coat's transmittance t(mu) from outside, by the same rows,
+// then (rows by roughness only) its internal reflectance by roughness.
 
 // Where x in [0, 1] falls in a grid of kEnergySize points: the cell and the weight.
 WT_HD WT_INLINE int energy_cell(float x, float& w) {
@@ -36,10 +36,17 @@ WT_HD WT_INLINE float cosine_table(const float* t, float mu) {
   return (1.0f - w) * t[j] + w * t[j + 1];
 }
 
-WT_HD WT_INLINE float conductor_energy(const float* t, float roughness, float mu) {
+// A table of `rows` rows of kEnergySize cosines each: one row, or kEnergySize rows
+// by roughness r_i = i / (kEnergySize - 1), read bilinearly.
+WT_HD WT_INLINE float rows_table(const float* t, int rows, float roughness, float mu) {
+  if (rows <= 1) return cosine_table(t, mu);
   float w;
   const int i = energy_cell(roughness, w);
   return (1.0f - w) * cosine_table(t + i * kEnergySize, mu) + w * cosine_table(t + (i + 1) * kEnergySize, mu);
+}
+
+WT_HD WT_INLINE float conductor_energy(const float* t, float roughness, float mu) {
+  return rows_table(t, kEnergySize, roughness, mu);
 }
 
 WT_HD WT_INLINE float conductor_average_energy(const float* t, float roughness) {

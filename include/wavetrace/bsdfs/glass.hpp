@@ -22,8 +22,9 @@ WT_HD WT_INLINE Ggx glass_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.f
 // 1 / E(mu_o) on wo's side where the glass is compensated, else 1.
 WT_HD WT_INLINE float glass_compensation(const BsdfAt& b, const vec3& wo) {
   if (!(b.flags & kMaterialCompensated) || b.p.table < 0) return 1.0f;
-  const float* t = b.tables + b.p.table + (wo.z > 0.0f ? 0 : kEnergySize);
-  return 1.0f / fmaxf(cosine_table(t, fabsf(wo.z)), 1e-3f);
+  const int rows = b.p.table_rows;
+  const float* t = b.tables + b.p.table + (wo.z > 0.0f ? 0 : rows * kEnergySize);
+  return 1.0f / fmaxf(rows_table(t, rows, table_roughness(glass_ggx(b)), fabsf(wo.z)), 1e-3f);
 }
 
 // f cos and the density, local frame about the outward normal (wo on either side).

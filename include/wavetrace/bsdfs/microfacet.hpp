@@ -72,6 +72,10 @@ WT_HD WT_INLINE Ggx ggx_from_roughness(float roughness, float anisotropy) {
   return Ggx{alpha / aspect, alpha * aspect};
 }
 
+// The roughness the energy tables are read at: that of the isotropic lobe of equal
+// alpha_x alpha_y.
+WT_HD WT_INLINE float table_roughness(const Ggx& g) { return sqrtf(sqrtf(g.ax * g.ay)); }
+
 WT_HD WT_INLINE vec3 reflect_about(const vec3& wo, const vec3& h) { return 2.0f * glm::dot(wo, h) * h - wo; }
 
 }  // namespace wt

@@ -20,7 +20,7 @@ WT_HD WT_INLINE Ggx plastic_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b
 // The coat's transmittance at mu from outside.
 WT_HD WT_INLINE float plastic_transmittance(const BsdfAt& b, const Ggx& g, float mu) {
   if (g.smooth() || b.p.table < 0) return 1.0f - fresnel_dielectric(mu, b.ior);
-  return cosine_table(b.tables + b.p.table, mu);
+  return rows_table(b.tables + b.p.table, b.p.table_rows, table_roughness(g), mu);
 }
 
 // The probability of sampling the coat rather than the base, from their expected

@@ -234,18 +234,24 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
     }
   }
   const vec3 e1 = tri.corner(1) - tri.corner(0), e2 = tri.corner(2) - tri.corner(0);
-  vec3 dpdu = e1;
+  vec3 dpdu = e1, dpdv = e2;
   if (sh.flags & kTriangleHasUvs) {
     const vec2 t0 = g.uv(sh.vertex[0]), t1 = g.uv(sh.vertex[1]), t2 = g.uv(sh.vertex[2]);
     sp.uv = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
-    // dp/du from p(u, v) over the triangle: solve the UV deltas of the two edges.
+    // dp/du and dp/dv from p(u, v) over the triangle: solve the UV deltas of the two edges.
     const vec2 d1 = t1 - t0, d2 = t2 - t0;
     const float det = d1.x * d2.y - d1.y * d2.x;
-    if (det != 0.0f) dpdu = (d2.y * e1 - d1.y * e2) * (1.0f / det);
+    if (det != 0.0f) {
+      const float inv = 1.0f / det;
+      dpdu = (d2.y * e1 - d1.y * e2) * inv;
+      dpdv = (d1.x * e2 - d2.x * e1) * inv;
+    }
   } else {
     sp.uv = vec2(hit.b1, hit.b2);
   }
   sp.dpdu = in.identity ? dpdu : in.world_from_object.vector(dpdu);
+  if (!in.identity) dpdv = in.world_from_object.vector(dpdv);
+  sp.tangent_sign = glm::dot(glm::cross(sp.n, sp.dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
   sp.has_uv = true;
   sp.front = glm::dot(ray.dir, sp.ng) < 0.0f;
   // The point's error along the normal, and the rounding of adding the offset to it

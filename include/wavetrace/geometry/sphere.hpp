@@ -66,6 +66,7 @@ WT_HD WT_INLINE SurfacePoint sphere_surface(const SphereGeom& s, const Ray& ray,
   sp.ng = sp.n;
   sp.uv = vec2(0.0f);
   sp.dpdu = vec3(-sp.local.z, 0.0f, sp.local.x);
+  sp.tangent_sign = -1.0f;  // u runs clockwise seen from outside; v = 0 is the north pole
   sp.has_uv = false;
   sp.front = glm::dot(ray.dir, sp.n) < 0.0f;
   sp.offset = kSphereSurfaceOffset;

@@ -14,6 +14,8 @@ struct SurfacePoint {
   vec2 uv;      // texture coordinates (triangles); spheres map theirs from n (texture.hpp)
   vec3 dpdu;    // the direction of increasing u (not unit; anisotropy's tangent): a
                 // sphere's azimuth, a triangle's from its UVs (its first edge without them)
+  float tangent_sign;  // +-1: the bitangent cross(n, dpdu) times this points up the image
+                       // (towards decreasing v), as a tangent-space normal map's +y
   bool has_uv;  // false: spheres
   bool front;   // the ray arrived from the outward side
   float offset;  // how far a secondary ray starts from p along ng: covers p's rounding error
