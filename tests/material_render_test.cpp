@@ -8,6 +8,7 @@
 //     kernel agrees with the CPU (the GPU suite).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -325,6 +326,33 @@ TEST(MaterialRender, AConstantTiltedNormalMapLightsLikeTheTiltedQuad) {
     // The untilted quad lights otherwise (by 16% and 34%): the test sees the map.
     EXPECT_GT(std::fabs(test::mean_and_standard_error(p).mean - lit), 0.1 * lit);
   }
+}
+
+// --profile's shade by material kind: the same image (to the film's rounding: the
+// launches add in another order), the kinds' times making up shade's, one for
+// each kind the scene's hits hold.
+TEST(MaterialRender, ShadingByKindRendersTheSameImageAndTimesEachKind) {
+  RenderOptions o = options_for(Backend::Cpu, Kernel::WavefrontSorted, 32, 18, 4, 8, 3, 1);
+  const RenderResult whole = render(materials_scene(), o);
+  o.shade_by_kind = true;
+  const RenderResult parts = render(materials_scene(), o);
+  ASSERT_EQ(parts.rgb.size(), whole.rgb.size());
+  for (size_t i = 0; i < whole.rgb.size(); ++i) {
+    ASSERT_NEAR(parts.rgb[i], whole.rgb[i], 1e-5f * (1.0f + std::fabs(whole.rgb[i]))) << i;
+  }
+  double shade = 0, sum = 0;
+  std::vector<std::string> timed;
+  for (const StageTime& s : parts.stages) {
+    if (s.name == "shade") shade = s.ms;
+    if (s.part) sum += s.ms;
+    if (s.part && s.ms > 0) timed.push_back(s.name);
+  }
+  // (Shade's own launches over a last bounce of no hits add a few microseconds.)
+  EXPECT_LE(sum, shade);
+  EXPECT_GT(sum, 0.98 * shade);
+  // The scene's kinds (its ground is plastic, its lamp emissive), and no other.
+  EXPECT_EQ(timed, (std::vector<std::string>{"  emissive", "  conductor", "  glass", "  plastic"}));
+  for (const StageTime& s : whole.stages) EXPECT_FALSE(s.part) << "only with shade_by_kind";
 }
 
 TEST(MaterialRender, EveryCudaKernelAgreesWithTheCpu) {

@@ -64,13 +64,20 @@ static_assert(sizeof(Material) == 44, "a material grows every constant-memory sc
 // Sort keys: the non-emissive kinds in order, four keys each (the texture slot: 0
 // untextured, 1 + TextureKind), then one key for emitters, whose hits only add
 // their emission; the miss key follows.
+constexpr uint32_t kEmitterSortKey = (kMaterialKindCount - 1) * 4;
 WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /* -1: none */) {
-  constexpr uint32_t kEmitterKey = (kMaterialKindCount - 1) * 4;
   const uint32_t k = static_cast<uint32_t>(kind);
-  if (kind == MaterialKind::Emissive) return kEmitterKey;
+  if (kind == MaterialKind::Emissive) return kEmitterSortKey;
   return (k < static_cast<uint32_t>(MaterialKind::Emissive) ? k : k - 1) * 4u + static_cast<uint32_t>(texture_kind + 1);
 }
-constexpr uint32_t kSortKeyCount = (kMaterialKindCount - 1) * 4 + 1;
+constexpr uint32_t kSortKeyCount = kEmitterSortKey + 1;
+// The kind a sort key belongs to (material_sort_key's inverse in the kind).
+WT_HD WT_INLINE MaterialKind sort_key_kind(uint32_t key) {
+  if (key >= kEmitterSortKey) return MaterialKind::Emissive;
+  const uint32_t slot = key / 4;
+  return static_cast<MaterialKind>(slot < static_cast<uint32_t>(MaterialKind::Emissive) ? slot : slot + 1);
+}
+
 // The microfacet kinds' keys (conductor, glass, plastic: four each, after the
 // study's four kinds), whose shading costs several times a Lambertian's.
 constexpr uint32_t kMicrofacetKeyMask = ((1u << 12) - 1) << ((static_cast<uint32_t>(MaterialKind::Conductor) - 1) * 4);

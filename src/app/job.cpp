@@ -105,10 +105,12 @@ void print_geometry(const Scene::Summary& g) {
 
 void print_profile(const RenderResult& r) {
   double total = 0;
-  for (const StageTime& s : r.stages) total += s.ms;
+  for (const StageTime& s : r.stages) total += s.part ? 0.0 : s.ms;
   std::fprintf(stderr, "%-10s %10s %7s\n", "stage", "ms", "share");
   for (const StageTime& s : r.stages) {
-    std::fprintf(stderr, "%-10s %10.2f %6.1f%%\n", s.name.c_str(), s.ms, total > 0 ? 100.0 * s.ms / total : 0.0);
+    if (s.part && s.ms == 0.0) continue;
+    std::fprintf(stderr, "%-10s %10.2f %6.1f%%%s\n", s.name.c_str(), s.ms, total > 0 ? 100.0 * s.ms / total : 0.0,
+                 s.part ? " (of shade, in sorted bounces)" : "");
   }
   std::fprintf(stderr, "%-10s %10.2f  (render %.2f ms; the rest is launch gaps)\n", "sum", total, r.seconds * 1e3);
   std::fprintf(stderr, "bounces %zu, live paths per bounce:", r.live_per_bounce.size());
@@ -222,6 +224,7 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.kernel = parse_kernel(job.kernel);
   options.backend = parse_backend(job.backend);
   options.warmup = static_cast<int>(job.warmup);
+  options.shade_by_kind = job.profile;
   options.wave_size = job.wave_size;
   options.threads = static_cast<int>(job.threads);
   options.devices = parse_devices(job.devices, options.backend, cuda::device_count());

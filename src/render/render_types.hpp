@@ -118,6 +118,10 @@ struct RenderOptions {
   // blocks it takes from the feed, of each pass of its samples, and its result's
   // paths counts them. Not with warm-ups (which render without it) or after_pass.
   PathFeed* path_feed = nullptr;
+  // The wavefront shades each sorted bounce one launch per material kind, timed as
+  // a stage each ("shade <kind>", added to the result's stages after the others;
+  // --profile). The image is the same; the shade stage's own time is then theirs.
+  bool shade_by_kind = false;
 };
 
 // What one device did in a render split over several (dispatch/split.hpp).
@@ -134,6 +138,7 @@ struct DeviceShare {
 struct StageTime {
   std::string name;
   double ms = 0;
+  bool part = false;  // a share of the stage before it (shade's per material kind), not a stage of its own
 };
 
 // What `RenderResult::rgb` holds: a backend adds every sample into its pixel;

@@ -47,6 +47,10 @@ constexpr Stage kSort{3, "sort"};
 constexpr Stage kShade{4, "shade"};
 constexpr Stage kShadow{5, "shadow"};
 constexpr std::array<Stage, 6> kAll = {kIntersect, kCompact, kReadback, kSort, kShade, kShadow};
+// Shade by material kind (RenderOptions::shade_by_kind), after the stages above.
+constexpr std::array<Stage, kMaterialKindCount> kShadeKinds = {
+    Stage{6, "  lambertian"}, Stage{7, "  metal"},     Stage{8, "  dielectric"}, Stage{9, "  coated"},
+    Stage{10, "  emissive"},  Stage{11, "  conductor"}, Stage{12, "  glass"},     Stage{13, "  plastic"}};
 }  // namespace stage
 
 // `wavefront` sorts a bounce's hits when they hold at least this many sort keys
@@ -102,6 +106,8 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const WaveView w = lay_out_wave(ex.wave_memory(wave_bytes(slots, temp_bytes)), slots, temp_bytes, &bytes);
   // The render's own film, or the one it adds into (options.device_film).
   auto film_memory = ex.alloc(options.device_film ? 0 : film_floats * sizeof(float), "wave allocation");
+  auto key_memory = ex.alloc(options.shade_by_kind ? sizeof(KeyStarts) : 0, "wave allocation");
+  KeyStarts* const key_starts = reinterpret_cast<KeyStarts*>(key_memory.get());
   float* film = options.device_film ? options.device_film : reinterpret_cast<float*>(film_memory.get());
 
   RenderResult out;
@@ -171,15 +177,33 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
 
         const uint32_t* list = w.selected;
         if (c.hits > 0) ++bounces_shaded;
-        if (c.hits > 0 && sorts_bounce(options.kernel, c.key_mask[cur])) {
+        const bool sorted = c.hits > 0 && sorts_bounce(options.kernel, c.key_mask[cur]);
+        if (sorted) {
           ++bounces_sorted;
           list = ex.sort(stage::kSort, w.selected, w.entries, c.hits, sort_bits(key_bits), w.temp, w.temp_bytes);
         }
+        const bool by_kind = options.shade_by_kind && sorted;
+        KeyStarts starts{};
+        if (by_kind) {
+          ex.launch(stage::kSort, kSortKeyMiss + 1, FindKeyStartsItem{list, c.hits, key_starts});
+          starts = ex.read(stage::kReadback, key_starts);
+        }
         with_kinds(shade_kinds, [&](auto kinds) {
-          ex.launch(stage::kShade, c.hits,
-                    ShadeItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur],
-                                                      &w.counters->queued[1 - cur], w.shadows, &w.counters->shadows,
-                                                      list, first, film});
+          using Item = ShadeItem<decltype(kinds)::value>;
+          const Item item{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], w.shadows,
+                          &w.counters->shadows, list, first, film};
+          if (!by_kind) {
+            ex.launch(stage::kShade, c.hits, item);
+          } else {
+            // The sorted list holds each key's entries together: one launch per key.
+            for (uint32_t k = 0; k < kSortKeyMiss; ++k) {
+              const uint32_t count = starts.at[k + 1] - starts.at[k];
+              if (count == 0) continue;
+              Item part = item;
+              part.list = list + starts.at[k];
+              ex.launch(stage::kShadeKinds[static_cast<uint32_t>(sort_key_kind(k))], count, part);
+            }
+          }
           if (light_sampling && c.hits > 0) {
             ex.launch(stage::kShadow, c.hits, ShadowItem<decltype(kinds)::value>{scene, w.shadows, w.counters, film});
           }
@@ -209,9 +233,15 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
     out.bounces_sorted = bounces_sorted;
     out.blocks = blocks;
     out.paths = paths_done;
-    const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size());
+    const std::vector<double> ms = ex.take_stage_ms(stage::kAll.size() + stage::kShadeKinds.size());
     out.stages.clear();
     for (const Stage& s : stage::kAll) out.stages.push_back(StageTime{s.name, ms[s.index]});
+    if (options.shade_by_kind) {
+      for (const Stage& s : stage::kShadeKinds) {
+        out.stages[stage::kShade.index].ms += ms[s.index];
+        out.stages.push_back(StageTime{s.name, ms[s.index], true});
+      }
+    }
     out.live_per_bounce = std::move(live_per_bounce);
   };
   for (int i = 0; i < options.warmup; ++i) run(false);
