@@ -44,11 +44,11 @@ EMITTED_PLUGINS = (
     "scene", "path", "perspective", "thinlens", "hdrfilm", "box", "independent",
     "sphere", "obj", "ply", "shapegroup", "instance",
     "diffuse", "twosided", "conductor", "roughconductor", "dielectric", "plastic",
-    "roughdielectric", "thindielectric", "roughplastic", "principled",
+    "roughdielectric", "thindielectric", "roughplastic", "principled", "normalmap",
     "area", "constant", "envmap", "bitmap", "rgb",
 )
 # Python plugins registered by load_scene when a dict names them.
-PYTHON_PLUGINS = ("wt_checker", "wt_scale", "wt_null")
+PYTHON_PLUGINS = ("wt_checker", "wt_scale", "wt_roughness", "wt_null")
 
 # Metal fuzz -> Beckmann roughness: equal mean-square slope of the half vector
 # at normal incidence. wavetrace's fuzzy mirror turns the reflection r into
@@ -85,6 +85,9 @@ GRADIENT_SKY_COLUMNS = 8
 # Angular and mirror-ball environments are resampled to a lat-long image of
 # this many rows (and twice as many columns) when the scene is loaded.
 RESAMPLED_SKY_ROWS = 512
+
+# wavetrace's wrap modes of an image texture where it names none (u, v).
+IMAGE_WRAP = ["repeat", "clamp"]
 
 
 class ConversionError(Exception):
@@ -876,14 +879,26 @@ class Converter:
                            "(high + low) / 2 x albedo = %s is used" % (t["name"], [round(x, 4) for x in mean]))
             return _rgb(mean)
         if kind == "image":
-            return self._image(self.file(t["file"]), t.get("colorspace", "srgb"), albedo, on_sphere)
+            return self._image(self.file(t["file"]), t.get("colorspace", "srgb"), albedo, on_sphere, t)
         raise ConversionError("unknown texture type %s" % kind)
 
-    def _image(self, path, colorspace, albedo, on_sphere):
+    def _image(self, path, colorspace, albedo, on_sphere, t=None):
+        """A bitmap; t: the scene's image texture (its wrap modes and UV
+        transform), None for a mesh file's own texture (which repeats both ways
+        in wavetrace, as glTF's default sampler)."""
+        wrap = t.get("wrap", IMAGE_WRAP) if t is not None else ["repeat", "repeat"]
+        wrap = [wrap, wrap] if isinstance(wrap, str) else list(wrap)
         d = {"type": "bitmap", "filename": path, "raw": colorspace == "linear",
-             "filter_type": "bilinear", "wrap_mode": "repeat"}
-        self.notes.add("image textures: Mitsuba's bitmap wraps v as well (wavetrace clamps it): "
-                       "differs within half a texel of the top and bottom rows")
+             "filter_type": "bilinear", "wrap_mode": wrap[0] if wrap[0] == wrap[1] else "repeat"}
+        if wrap[0] != wrap[1]:
+            # Mitsuba's bitmap has one wrap mode for both axes.
+            self.notes.add("image textures: Mitsuba's bitmap wraps u and v alike (repeat), wavetrace %s u and %s "
+                           "v: differs within half a texel of the %s" % (
+                               wrap[0], wrap[1], "top and bottom rows" if wrap[0] == "repeat" else "edges"))
+        if t is not None and any(k in t and t[k] != v for k, v in (("uv_scale", [1, 1]), ("uv_offset", [0, 0]),
+                                                                    ("uv_rotation", 0))):
+            self.notes.add("image texture '%s': its uv_scale, uv_offset and uv_rotation are not converted "
+                           "(Mitsuba reads it at the surface's own UVs)" % t["name"])
         if on_sphere:
             d["to_uv"] = transform(SPHERE_TO_UV)
         if not _is_white(albedo) and not self.allow_python:
@@ -900,13 +915,114 @@ class Converter:
         if "texture" in m:
             return self.texture(m["texture"], albedo, on_sphere, to_object)
         if "__image__" in m:
-            return self._image(m["__image__"]["file"], m["__image__"]["colorspace"], albedo, on_sphere)
+            return self._image(m["__image__"]["file"], m["__image__"]["colorspace"], albedo, on_sphere, None)
         return _rgb(albedo)
 
     def object_space(self, m):
-        """Whether the material's texture is a function of the object-space point."""
-        t = self.textures.get(m.get("texture", ""))
-        return t is not None and t["type"] == "checker"
+        """Whether one of the material's textures (its albedo's, its roughness's)
+        is a function of the object-space point."""
+        for key in ("texture", "roughness_texture"):
+            t = self.textures.get(m.get(key, ""))
+            if t is not None and t["type"] == "checker":
+                return True
+        return False
+
+    @staticmethod
+    def roughness_of(m):
+        """A microfacet material's roughness: 1 by default where a roughness
+        texture scales it, 0 otherwise (as wavetrace reads it)."""
+        return float(m.get("roughness", 1.0 if "roughness_texture" in m else 0.0))
+
+    def textured(self, m, value, power, on_sphere, to_object, takes_texture=True):
+        """VALUE (an alpha, power 2, or a roughness, power 1) times the green
+        channel of the material's roughness_texture to the power POWER, as
+        wavetrace scales alpha at each hit: a wt_roughness texture (Python) where
+        the Mitsuba parameter takes a texture and the pattern converts; else one
+        number, from the texture's mean green (noted). VALUE where the material
+        has no roughness texture."""
+        name = m.get("roughness_texture")
+        if name is None:
+            return value
+        t = self.textures.get(name)
+        if t is None:
+            raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
+        if takes_texture and self.allow_python and t["type"] in ("checker", "image"):
+            self.python_plugins.add("wt_roughness")
+            return {"type": "wt_roughness", "texture": self._texture(t, [1, 1, 1], on_sphere, to_object),
+                    "scale": float(value), "power": float(power)}
+        if not takes_texture:
+            why = "Mitsuba's roughplastic takes one alpha (its tables are computed for it)"
+        elif not self.allow_python:
+            why = "without Python plugins Mitsuba cannot square a texture (alpha = (roughness x green)^2)"
+        else:
+            why = "a noise texture has no Mitsuba counterpart"
+
+        def clamp(x):
+            return min(max(float(x), 0.0), 1.0)
+
+        if t["type"] == "image":
+            out = {"__green_mean__": {"file": self.file(t["file"]), "srgb": t.get("colorspace", "srgb") == "srgb",
+                                      "scale": float(value), "power": float(power)}}
+            mean, value_text = "its mean green over the texels (computed when the scene is loaded)", ""
+        else:
+            a, b = (t["even"], t["odd"]) if t["type"] == "checker" else (t["high"], t["low"])
+            g = 0.5 * (clamp(a[1]) + clamp(b[1]))
+            out = float(value) * g ** power
+            mean = "its mean green %s = %g" % ("(even + odd) / 2" if t["type"] == "checker" else "(high + low) / 2", g)
+            value_text = " = %.6g" % out
+        self.notes.add("roughness_texture '%s' of '%s': the textured roughness does not map exactly: %s; %s "
+                       "gives one %s over the whole surface, (roughness x mean)%s%s (wavetrace: (roughness x "
+                       "green)%s at each hit)" % (name, m["name"], why, mean, "roughness" if power == 1 else "alpha",
+                                                  "" if power == 1 else "^2", value_text, "" if power == 1 else "^2"))
+        return out
+
+    def normal_map(self, m, b, on_sphere):
+        """B wrapped in Mitsuba's normalmap where the material has a normal_texture
+        that converts (an image): the map perturbs the shading frame of the BSDF
+        inside, twosided included, so that a surface's back sees the map turned
+        with it, as in wavetrace."""
+        name = m.get("normal_texture")
+        if name is None:
+            return b
+        t = self.textures.get(name)
+        if t is None:
+            raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
+        strength = float(m.get("normal_strength", 1.0))
+        if strength == 0:
+            return b   # the unperturbed normal, in wavetrace too
+        if t["type"] != "image":
+            self.notes.add("normal_texture '%s' of '%s': a %s texture used as a normal map does not map (Mitsuba's "
+                           "normalmap reads a texture's colour in its shading frame, and the procedural pattern is "
+                           "not converted to one): converted without its normal map" % (name, m["name"], t["type"]))
+            return b
+        if t.get("colorspace", "srgb") != "linear":
+            raise ConversionError("material '%s': normal_texture '%s' is read as sRGB; a normal map needs "
+                                  "\"colorspace\": \"linear\" (wavetrace refuses it too)" % (m["name"], name))
+        if strength != 1:
+            self.notes.add("normal_strength %g of '%s': Mitsuba's normalmap has no strength; the map is used as it "
+                           "is (strength 1)" % (strength, m["name"]))
+        if on_sphere:
+            self.notes.add("normal maps on spheres: both tangent frames run along the azimuth and up the image "
+                           "(towards the +y pole), but Mitsuba's dp/du points the other way round (SPHERE_FRAME "
+                           "turns its u against wavetrace's; to_uv turns the texture back): the map's x (red) tilts "
+                           "the normal the mirrored way in Mitsuba, its y (green) the same way")
+        else:
+            self.notes.add("normal maps on meshes: Mitsuba's normalmap works in its shading frame, s = dp/du (of the "
+                           "UVs) made orthogonal to the shading normal n, t = cross(n, s); wavetrace's tangent is the "
+                           "same, its bitangent cross(n, dp/du) times the UV handedness (so +y is up the image on "
+                           "every triangle): the frames agree where a triangle's UVs are not mirrored (seen from the "
+                           "front, the image is not flipped), the map's y (green) tilts the other way on mirrored "
+                           "ones, and on a mesh without UVs the tangents differ (wavetrace: the triangle's first "
+                           "edge; Mitsuba: an arbitrary frame about n)")
+        self.notes.add("normal maps: where the viewer is below the mapped normal, wavetrace turns the normal towards "
+                       "it (to a cosine of 0.01) and Mitsuba's normalmap mirrors the normal's tilt "
+                       "(flip_invalid_normals); Mitsuba drops directions on different sides of the mapped and the "
+                       "unmapped shading normal, where wavetrace absorbs reflections that cross the geometric "
+                       "surface; Mitsuba's shadow-terminator term is off (use_shadowing_function false: wavetrace "
+                       "has none)")
+        bitmap = self._image(self.file(t["file"]), "linear", [1, 1, 1], on_sphere, t)
+        return {"type": "normalmap", "normalmap": bitmap, "flip_invalid_normals": True,
+                "use_shadowing_function": False, "bsdf": b}
 
     def bsdf(self, m, on_sphere, to_object):
         """The BSDF dict of a wavetrace material (no id)."""
@@ -942,9 +1058,9 @@ class Converter:
             # here too (zero throughput, and no light sample at a delta BSDF).
             b = {"type": "conductor", "material": "none", "specular_reflectance": _rgb([0, 0, 0])}
         elif kind == "conductor":
-            b = self.conductor(m, on_sphere)
+            b = self.conductor(m, on_sphere, to_object)
         elif kind == "glass":
-            b = self.glass(m)
+            b = self.glass(m, on_sphere, to_object)
         elif kind == "plastic":
             b = self.plastic(m, on_sphere, to_object)
         else:
@@ -954,7 +1070,7 @@ class Converter:
             # ray), and its conductors and plastics either side of any surface;
             # Mitsuba's BSDFs are one-sided unless wrapped.
             b = {"type": "twosided", "bsdf": b}
-        return b
+        return self.normal_map(m, b, on_sphere)
 
     def _compensation_note(self, m, how, mitsuba):
         """A note where wavetrace compensates the multiple scattering that the
@@ -974,12 +1090,13 @@ class Converter:
         if masking == MASKINGS[0]:
             self.notes.add(SMITH_NOTE)
 
-    def conductor(self, m, on_sphere=True):
+    def conductor(self, m, on_sphere=True, to_object=None):
         """wavetrace's conductor: GGX with alpha = roughness^2, stretched by
         anisotropy along the tangent (a sphere's direction of increasing u, the
         azimuth, which Mitsuba's sphere frame also takes for its s axis:
         SPHERE_FRAME turns u the other way round, and GGX is even in it)."""
-        roughness = float(m.get("roughness", 0))
+        to_object = to_object if to_object is not None else mat_identity()
+        roughness = self.roughness_of(m)
         anisotropy = float(m.get("anisotropy", 0))
         alpha = roughness * roughness
         aspect = math.sqrt(1.0 - 0.9 * anisotropy)
@@ -996,7 +1113,10 @@ class Converter:
             # metallic lobe of Mitsuba's principled BSDF (metallic 1: no diffuse,
             # sheen, clearcoat or transmission; spec_tint unset), with GGX, Smith
             # masking and the same roughness / anisotropy mapping (Disney's).
-            b = {"type": "principled", "base_color": _rgb(m["f0"]), "metallic": 1.0, "roughness": roughness}
+            # Principled squares its roughness itself: a roughness texture scales
+            # it linearly (power 1).
+            b = {"type": "principled", "base_color": _rgb(m["f0"]), "metallic": 1.0,
+                 "roughness": self.textured(m, roughness, 1, on_sphere, to_object)}
             if anisotropy > 0:
                 b["anisotropic"] = anisotropy
             self.notes.add("conductor with f0 -> principled, metallic 1, base_color = f0: Schlick's Fresnel at "
@@ -1026,18 +1146,20 @@ class Converter:
             return b
         b.update({"type": "roughconductor", "distribution": "ggx", "sample_visible": True})
         if anisotropy > 0:
-            b["alpha_u"], b["alpha_v"] = alpha_x, alpha_y
+            b["alpha_u"] = self.textured(m, alpha_x, 2, on_sphere, to_object)
+            b["alpha_v"] = self.textured(m, alpha_y, 2, on_sphere, to_object)
         else:
-            b["alpha"] = alpha
+            b["alpha"] = self.textured(m, alpha, 2, on_sphere, to_object)
         self._compensation_note(m, CONDUCTOR_COMPENSATION, "roughconductor")
         return b
 
-    def glass(self, m):
+    def glass(self, m, on_sphere=True, to_object=None):
         """wavetrace's glass: exact dielectric Fresnel, GGX (alpha = roughness^2)
         where rough, 1/eta^2 on refraction (Mitsuba's radiance mode), the tint
         on transmission only."""
+        to_object = to_object if to_object is not None else mat_identity()
         ior = float(m.get("ior", 1.5))
-        roughness = float(m.get("roughness", 0))
+        roughness = self.roughness_of(m)
         alpha = roughness * roughness
         if m.get("thin", False):
             if roughness > 0:
@@ -1048,7 +1170,8 @@ class Converter:
             # (and roughdielectric refuses equal indices).
             b = {"type": "dielectric", "int_ior": ior, "ext_ior": 1.0}
         else:
-            b = {"type": "roughdielectric", "distribution": "ggx", "alpha": alpha, "sample_visible": True,
+            b = {"type": "roughdielectric", "distribution": "ggx", "sample_visible": True,
+                 "alpha": self.textured(m, alpha, 2, on_sphere, to_object),
                  "int_ior": ior, "ext_ior": 1.0}
             self._masking_note(m)
             self._compensation_note(m, GLASS_COMPENSATION, "roughdielectric")
@@ -1060,7 +1183,7 @@ class Converter:
     def plastic(self, m, on_sphere, to_object):
         """wavetrace's plastic: Mitsuba's plastic / roughplastic, nonlinear."""
         ior = float(m.get("ior", 1.5))
-        roughness = float(m.get("roughness", 0))
+        roughness = self.roughness_of(m)
         alpha = roughness * roughness
         b = {"diffuse_reflectance": self.reflectance(m, on_sphere, to_object), "int_ior": ior, "ext_ior": 1.0,
              "nonlinear": True}
@@ -1074,7 +1197,8 @@ class Converter:
                                "(R_int) is a fitted formula in Mitsuba, %.4f, the integral in wavetrace, %.4f "
                                "(%+.2f%%)" % (ior, fit, exact, 100.0 * (fit / exact - 1.0)))
         else:
-            b.update({"type": "roughplastic", "distribution": "ggx", "alpha": alpha, "sample_visible": True})
+            b.update({"type": "roughplastic", "distribution": "ggx", "sample_visible": True,
+                      "alpha": self.textured(m, alpha, 2, on_sphere, to_object, takes_texture=False)})
             self._masking_note(m)
         return b
 
@@ -1391,6 +1515,36 @@ def register_python_plugins(mi, dr, names):
 
         mi.register_texture("wt_scale", lambda props: Scale(props))
 
+    if "wt_roughness" in names:
+        class Roughness(mi.Texture):
+            """A roughness texture's effect on alpha (power 2) or on a roughness
+            (power 1): scale x clamp(green, 0, 1)^power, at each lookup."""
+
+            def __init__(self, props):
+                mi.Texture.__init__(self, props)
+                self.nested = props.get("texture")
+                self.scale = props.get("scale")
+                self.square = props.get("power") == 2.0
+
+            def eval_1(self, si, active=True):
+                g = dr.clip(self.nested.eval(si, active)[1], 0.0, 1.0)
+                return self.scale * (g * g if self.square else g)
+
+            def eval(self, si, active=True):
+                return mi.Color3f(self.eval_1(si, active))
+
+            def mean(self):
+                g = min(max(self.nested.mean(), 0.0), 1.0)
+                return self.scale * (g * g if self.square else g)
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceRoughness[scale=%g, power=%d]" % (self.scale, 2 if self.square else 1)
+
+        mi.register_texture("wt_roughness", lambda props: Roughness(props))
+
     if "wt_null" in names:
         def zeros(cls):
             try:
@@ -1469,6 +1623,19 @@ def _sample_rows(w, h, rows, u, v):
     return out
 
 
+_GREEN_MEANS = {}
+
+
+def green_mean(mi, path, srgb):
+    """The mean over the texels of an image's green channel (linear, clamped to
+    [0, 1], as wavetrace reads a roughness texture's)."""
+    key = (os.path.abspath(path), bool(srgb))
+    if key not in _GREEN_MEANS:
+        w, h, rows = _bitmap_rows(mi, path, srgb)
+        _GREEN_MEANS[key] = sum(min(max(g, 0.0), 1.0) for row in rows for g in row[1::3]) / (w * h)
+    return _GREEN_MEANS[key]
+
+
 def environment_uv(mapping, e):
     """wavetrace's environment_uv (include/wavetrace/sky.hpp) for a unit direction."""
     x, y, z = e
@@ -1518,6 +1685,9 @@ def realize(mi, d):
     if isinstance(d, dict):
         if "__transform__" in d:
             return mi.ScalarTransform4f(mi.ScalarMatrix4f(d["__transform__"]))
+        if "__green_mean__" in d:
+            spec = d["__green_mean__"]
+            return spec["scale"] * green_mean(mi, spec["file"], spec["srgb"]) ** spec["power"]
         out = {}
         for k, v in d.items():
             if k == "__envmap_image__":

@@ -6,8 +6,9 @@ image, and writes them side by side with their difference.
     peer_regions.py WAVETRACE.pfm PEER.exr [--regions REGIONS.json] [--png OUT.png]
                     [--json OUT.json] [--bound 0.01]
 
-Each sphere's mean over its `inner` box (every pixel inside the silhouette), both
-images' channel means, and the relative difference (wavetrace - peer) / peer.
+Each sphere's (and the plane's) mean over its `inner` box (every pixel inside
+the silhouette), both images' channel means, and the relative difference
+(wavetrace - peer) / peer.
 The noise of that difference is estimated from the 2 x 2 blocks of the box: the
 standard error of the block means' differences, an upper bound where the shading
 varies inside a block. --bound marks the spheres whose |difference| exceeds it.
@@ -88,7 +89,7 @@ def main(argv=None):
         if (regions["width"], regions["height"]) != (wt.shape[1], wt.shape[0]):
             raise SystemExit("%s is for %d x %d, the images are %d x %d" % (
                 a.regions, regions["width"], regions["height"], wt.shape[1], wt.shape[0]))
-        boxes = [(s["material"], s["inner"]) for s in regions["spheres"]]
+        boxes = [(s["material"], s["inner"]) for s in regions["spheres"] + regions.get("planes", [])]
     else:
         boxes = [("image", [0, 0, wt.shape[1], wt.shape[0]])]
     for name, (x0, y0, x1, y1) in boxes:

@@ -630,6 +630,141 @@ class MicrofacetMaterialTest(Base):
         self.assertAlmostEqual(mp.diffuse_fresnel(1 / 1.5), 0.59635, places=4)
 
 
+class TexturedMaterialTest(Base):
+    """roughness_texture and normal_texture (include/wavetrace/bsdf.hpp's bsdf_at)."""
+
+    TEXTURES = [
+        {"name": "squares", "type": "checker", "size": 0.5, "even": [1, 1, 1], "odd": [0.3, 0.2, 0.1]},
+        {"name": "veins", "type": "noise", "scale": 4, "high": [1, 0.8, 1], "low": [0, 0.4, 0]},
+        {"name": "map", "type": "image", "file": os.path.join(ROOT, "scenes/textures/bumps_normal.png"),
+         "colorspace": "linear", "wrap": "repeat"},
+        {"name": "map_srgb", "type": "image", "file": os.path.join(ROOT, "scenes/textures/bumps_normal.png")},
+    ]
+
+    def bsdfs(self, materials, **kw):
+        spheres = [{"center": [3 * k, 0, 0], "radius": 1, "material": m["name"]} for k, m in enumerate(materials)]
+        conv = self.convert(scene_doc(textures=self.TEXTURES, materials=materials, spheres=spheres), **kw)
+        return conv, [self.bsdf_of(conv, s) for s in self.shapes(conv, "sphere")]
+
+    def test_roughness_texture_scales_alpha_where_mitsuba_takes_a_texture(self):
+        conv, b = self.bsdfs([
+            {"name": "c", "type": "conductor", "metal": "gold", "roughness": 0.6, "roughness_texture": "squares"},
+            {"name": "default", "type": "conductor", "metal": "gold", "roughness_texture": "squares"},
+            {"name": "aniso", "type": "conductor", "metal": "gold", "roughness": 0.5, "anisotropy": 0.8,
+             "roughness_texture": "map"},
+            {"name": "f0", "type": "conductor", "f0": [0.9, 0.8, 0.7], "roughness": 0.4,
+             "roughness_texture": "squares"},
+            {"name": "g", "type": "glass", "roughness": 0.7, "roughness_texture": "squares"},
+            {"name": "smooth", "type": "conductor", "metal": "gold", "roughness": 0, "roughness_texture": "squares"},
+        ])
+        c, default, aniso, f0, g, smooth = b
+        alpha = c["bsdf"]["alpha"]
+        self.assertEqual((alpha["type"], alpha["scale"], alpha["power"]), ("wt_roughness", 0.36, 2.0))
+        checker = alpha["texture"]
+        self.assertEqual((checker["type"], checker["odd_g"]), ("wt_checker", 0.2))
+        self.assertEqual([checker["ox%d" % k] for k in range(4)], [1.0, 0.0, 0.0, 0.0])   # the sphere at x = 0
+        self.assertEqual(default["bsdf"]["alpha"]["scale"], 1.0)          # roughness 1 with a roughness texture
+        aspect = math.sqrt(1 - 0.9 * 0.8)
+        self.assertAlmostEqual(aniso["bsdf"]["alpha_u"]["scale"], 0.25 / aspect)
+        self.assertAlmostEqual(aniso["bsdf"]["alpha_v"]["scale"], 0.25 * aspect)
+        self.assertEqual(aniso["bsdf"]["alpha_u"]["texture"]["type"], "bitmap")
+        self.assertEqual(aniso["bsdf"]["alpha_u"]["texture"]["raw"], True)
+        rough = f0["bsdf"]["roughness"]                                  # principled squares it itself
+        self.assertEqual((rough["type"], rough["scale"], rough["power"]), ("wt_roughness", 0.4, 1.0))
+        self.assertEqual(g["type"], "roughdielectric")
+        self.assertAlmostEqual(g["alpha"]["scale"], 0.49)
+        self.assertEqual(smooth["bsdf"]["type"], "conductor")             # 0 times anything: a mirror
+        self.assertIn("wt_roughness", conv.python_plugins)
+        self.assertIn("wt_checker", conv.python_plugins)
+        self.assertFalse(any("roughness_texture" in n for n in conv.notes))
+        # A checker is a function of the object-space point: one BSDF per sphere.
+        doc = scene_doc(textures=self.TEXTURES, materials=[{"name": "c", "type": "conductor", "metal": "gold",
+                                                             "roughness_texture": "squares"}],
+                        spheres=[{"center": [k, 0, 0], "radius": 0.2, "material": "c"} for k in range(2)])
+        shapes = self.shapes(self.convert(doc), "sphere")
+        self.assertEqual([s["bsdf"]["type"] for s in shapes], ["twosided", "twosided"])
+        self.assertEqual(shapes[1]["bsdf"]["bsdf"]["alpha"]["texture"]["ox3"], -1.0)
+
+    def test_roughness_texture_falls_back_to_its_mean(self):
+        conv, b = self.bsdfs([
+            {"name": "p", "type": "plastic", "roughness": 0.5, "roughness_texture": "squares"},
+            {"name": "n", "type": "conductor", "metal": "gold", "roughness": 0.5, "roughness_texture": "veins"},
+            {"name": "i", "type": "plastic", "roughness": 0.5, "roughness_texture": "map"},
+        ])
+        p, n, i = b
+        self.assertAlmostEqual(p["bsdf"]["alpha"], (0.5 * 0.6) ** 2)     # (even + odd) / 2 = 0.6
+        self.assertAlmostEqual(n["bsdf"]["alpha"], (0.5 * 0.6) ** 2)     # (high + low) / 2 = 0.6
+        self.assertEqual(i["bsdf"]["alpha"], {"__green_mean__": {
+            "file": os.path.join(ROOT, "scenes/textures/bumps_normal.png"), "srgb": False, "scale": 0.25,
+            "power": 2.0}})
+        notes = " ".join(conv.notes)
+        self.assertIn("roughness_texture 'squares' of 'p': the textured roughness does not map exactly: "
+                      "Mitsuba's roughplastic takes one alpha", notes)
+        self.assertIn("roughness_texture 'veins' of 'n'", notes)
+        self.assertIn("a noise texture has no Mitsuba counterpart", notes)
+        self.assertIn("its mean green over the texels", notes)
+        conv, b = self.bsdfs([{"name": "c", "type": "conductor", "metal": "gold", "roughness": 0.5,
+                               "roughness_texture": "squares"}], python_plugins=False)
+        self.assertAlmostEqual(b[0]["bsdf"]["alpha"], (0.5 * 0.6) ** 2)
+        self.assertIn("cannot square a texture", " ".join(conv.notes))
+        self.assertEqual(conv.python_plugins, [])
+
+    def test_normal_map_wraps_the_bsdf(self):
+        conv, b = self.bsdfs([
+            {"name": "p", "type": "plastic", "roughness": 0.3, "normal_texture": "map"},
+            {"name": "l", "type": "lambertian", "normal_texture": "map", "normal_strength": 0.5},
+            {"name": "g", "type": "glass", "roughness": 0.2, "normal_texture": "map"},
+            {"name": "flat", "type": "lambertian", "normal_texture": "map", "normal_strength": 0},
+            {"name": "proc", "type": "conductor", "metal": "gold", "normal_texture": "squares"},
+        ])
+        p, l, g, flat, proc = b
+        self.assertEqual((p["type"], p["flip_invalid_normals"], p["use_shadowing_function"]),
+                         ("normalmap", True, False))
+        self.assertEqual(p["bsdf"]["type"], "twosided")                  # the map outside: it turns with the back
+        self.assertEqual(p["bsdf"]["bsdf"]["type"], "roughplastic")
+        nm = p["normalmap"]
+        self.assertEqual((nm["type"], nm["raw"], nm["wrap_mode"]), ("bitmap", True, "repeat"))
+        self.assertEqual(nm["to_uv"]["__transform__"], mp.SPHERE_TO_UV)
+        self.assertEqual((l["type"], l["bsdf"]["type"]), ("normalmap", "diffuse"))
+        self.assertEqual((g["type"], g["bsdf"]["type"]), ("normalmap", "roughdielectric"))
+        self.assertEqual(flat["type"], "diffuse")                         # strength 0: no perturbation
+        self.assertEqual(proc["type"], "twosided")                        # not mapped
+        notes = " ".join(conv.notes)
+        for fragment in ("normal_strength 0.5 of 'l'", "normal_texture 'squares' of 'proc': a checker texture "
+                         "used as a normal map does not map", "normal maps on spheres", "flip_invalid_normals",
+                         "its y (green) the same way"):
+            self.assertIn(fragment, notes)
+        self.assertNotIn("normal maps on meshes", notes)
+        self.assertIn("normalmap", conv.plugins())
+        with self.assertRaisesRegex(mp.ConversionError, "colorspace"):
+            self.bsdfs([{"name": "s", "type": "lambertian", "normal_texture": "map_srgb"}])
+
+    def test_normal_map_on_a_mesh(self):
+        conv = mp.convert(os.path.join(ROOT, "scenes", "materials-single.json"))
+        maps = [v for v in conv.scene.values() if isinstance(v, dict) and v.get("type") == "normalmap"]
+        self.assertEqual(len(maps), 1)
+        self.assertEqual(maps[0]["normalmap"]["filename"], os.path.join(ROOT, "scenes", "textures", "bumps_normal.png"))
+        self.assertNotIn("to_uv", maps[0]["normalmap"])
+        notes = " ".join(conv.notes)
+        self.assertIn("normal maps on meshes", notes)
+        self.assertIn("the frames agree where a triangle's UVs are not mirrored", notes)
+        self.assertNotIn("Mitsuba's bitmap wraps", notes)                 # "wrap": "repeat" on both axes
+
+    def test_image_wrap_modes(self):
+        path = os.path.join(ROOT, "scenes/textures/planet.png")
+        textures = [{"name": "a", "type": "image", "file": path},
+                    {"name": "b", "type": "image", "file": path, "wrap": "clamp"},
+                    {"name": "c", "type": "image", "file": path, "wrap": ["mirror", "mirror"], "uv_scale": [2, 2]}]
+        materials = [{"name": k, "type": "lambertian", "texture": k} for k in "abc"]
+        spheres = [{"center": [3 * i, 0, 0], "radius": 1, "material": k} for i, k in enumerate("abc")]
+        conv = self.convert(scene_doc(textures=textures, materials=materials, spheres=spheres))
+        modes = [self.bsdf_of(conv, s)["reflectance"]["wrap_mode"] for s in self.shapes(conv, "sphere")]
+        self.assertEqual(modes, ["repeat", "clamp", "mirror"])
+        notes = " ".join(conv.notes)
+        self.assertIn("wavetrace repeat u and clamp v", notes)            # the default: [repeat, clamp]
+        self.assertIn("image texture 'c': its uv_scale, uv_offset and uv_rotation are not converted", notes)
+
+
 class ConductorPresetsTest(Base):
     def test_the_repository_header(self):
         presets = mp.conductor_presets()
@@ -681,6 +816,48 @@ class MaterialScenesTest(Base):
             with open(os.path.join(ROOT, "scenes", file)) as f:
                 self.assertEqual(f.read(), scenefile.dumps_scene(scene), file)
 
+    def test_committed_plane_and_normal_map_are_the_generators(self):
+        import make_materials as mm
+        import make_normal_map as mn
+        mm.write_plane(self.tmp)
+        for name in (mm.PLANE_STEM + ".obj",):
+            with open(os.path.join(self.tmp, name)) as a, open(os.path.join(ROOT, "scenes", name)) as b:
+                self.assertEqual(a.read(), b.read(), name)
+        # The pixels (the bytes depend on zlib's version as well).
+        w, h, rows = mn.read_png(os.path.join(ROOT, "scenes", "textures", "bumps_normal.png"))
+        self.assertEqual((w, h), (mn.SIZE, mn.SIZE))
+        self.assertEqual(rows, mn.normal_map())
+        self.assertEqual(rows[0][:3], bytes((128, 128, 255)))            # flat between the bumps
+        # It tiles: the first column continues the last, the first row the last.
+        for a, b in ((rows[0], rows[-1]), (rows[100][:3], rows[100][-3:])):
+            self.assertTrue(all(abs(x - y) <= 12 for x, y in zip(a, b)))
+        # OpenGL's convention: above a bump's centre the normal leans up the image
+        # (green > 0.5), right of it towards +u (red > 0.5).
+        cx, cy = [int(v) for v in mn.bump_centres()[0]]
+        self.assertGreater(rows[cy - 13][3 * cx + 1], 200)
+        self.assertGreater(rows[cy][3 * (cx + 13)], 200)
+
+    def test_plane_faces_up_with_a_right_handed_uv_frame(self):
+        # wavetrace's tangent_sign (geometry.hpp) is +1 where cross(n, dp/du) runs
+        # against dp/dv (v = 1 - OBJ's v): there Mitsuba's t = cross(n, s) is
+        # wavetrace's bitangent, so the two tangent frames agree.
+        import make_materials as mm
+        corners, uvs = mm.plane_corners()
+        for tri in ((0, 1, 2), (0, 2, 3)):
+            p = [corners[i] for i in tri]
+            t = [(uvs[i][0], 1 - uvs[i][1]) for i in tri]
+            e1, e2 = [[p[k][i] - p[0][i] for i in range(3)] for k in (1, 2)]
+            n = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]
+            self.assertGreater(n[1], 0)
+            d1, d2 = [[t[k][i] - t[0][i] for i in range(2)] for k in (1, 2)]
+            det = d1[0] * d2[1] - d1[1] * d2[0]
+            dpdu = [(d2[1] * e1[i] - d1[1] * e2[i]) / det for i in range(3)]
+            dpdv = [(d1[0] * e2[i] - d2[0] * e1[i]) / det for i in range(3)]
+            b = [n[1] * dpdu[2] - n[2] * dpdu[1], n[2] * dpdu[0] - n[0] * dpdu[2], n[0] * dpdu[1] - n[1] * dpdu[0]]
+            self.assertLess(sum(x * y for x, y in zip(b, dpdv)), 0)
+            self.assertLess(dpdu[0], 0)                                 # u along -x: the image's right
+            self.assertGreater(b[2], 0)                                 # up the image: +z, away from the camera
+
     def test_single_is_mitsubas_models(self):
         for stem in ("materials", "cornell-materials"):
             with open(os.path.join(ROOT, "scenes", stem + ".json")) as f:
@@ -707,9 +884,20 @@ class MaterialScenesTest(Base):
         scene = mm.build_table()
         for w, h in ((1920, 1080), (960, 540)):
             regs = mm.regions(scene, w, h)
+            planes = mm.plane_regions(scene, w, h)
             self.assertEqual(len(regs), len(scene["spheres"]) - 1)
-            self.assertEqual(mm.overlapping(regs, w, h), [])
+            self.assertEqual([p["material"] for p in planes], ["bumpy-plastic"])
+            self.assertEqual(mm.overlapping(regs + planes, w, h), [])
             proj = mm.Projection(scene["camera"], w, h)
+            for p in planes:
+                x0, y0, x1, y1 = p["bbox"]
+                ix0, iy0, ix1, iy1 = p["inner"]
+                self.assertTrue(x0 < ix0 < ix1 < x1 and y0 < iy0 < iy1 < y1)
+                corners = [proj.pixel(c) for c in p["corners"]]
+                self.assertEqual([x0, y0], [math.floor(min(c[0] for c in corners)),
+                                            math.floor(min(c[1] for c in corners))])
+                self.assertEqual([x1, y1], [math.ceil(max(c[0] for c in corners)),
+                                            math.ceil(max(c[1] for c in corners))])
             for r in regs:
                 x0, y0, x1, y1 = r["bbox"]
                 ix0, iy0, ix1, iy1 = r["inner"]
@@ -817,6 +1005,76 @@ class MitsubaModelTest(Base):
             si.wi = mi.Vector3f(wi)
             self.assertAlmostEqual(b.eval(mi.BSDFContext(), si, mi.Vector3f(wo))[0] / want, 1.0, places=5)
 
+    def test_sphere_frame_is_wavetraces_but_for_the_tangents_sign(self):
+        # The normal-map note: on a sphere Mitsuba's s is wavetrace's -T (T the
+        # azimuth, dp/du = (-n.z, 0, n.x)) and its t = cross(n, s) is wavetrace's
+        # bitangent cross(n, T) x tangent_sign (-1 on spheres, sphere.hpp).
+        mi, dr = self.mi, __import__("drjit")
+        c, r = [1.0, 2.0, 3.0], 0.7
+        to_world = mp.mat_mul(mp.mat_mul(mp.mat_translate(c), mp.SPHERE_FRAME), mp.mat_scale(r))
+        sphere = {"type": "sphere", "to_world": mp.realize(mi, mp.transform(to_world))}
+        scene = mi.load_dict({"type": "scene", "s": sphere})
+        for d in ([0.3, -0.2, 1.0], [-0.5, 0.4, 1.0], [0.1, 0.6, -1.0]):
+            si = scene.ray_intersect(mi.Ray3f([c[i] - 5 * d[i] for i in range(3)], dr.normalize(mi.Vector3f(d))))
+            n = [si.n.x, si.n.y, si.n.z]
+            t = [-n[2], 0.0, n[0]]
+            ln = math.sqrt(sum(x * x for x in t))
+            t = [x / ln for x in t]
+            b = [-(n[1] * t[2] - n[2] * t[1]), -(n[2] * t[0] - n[0] * t[2]), -(n[0] * t[1] - n[1] * t[0])]
+            s_mi = [si.sh_frame.s.x, si.sh_frame.s.y, si.sh_frame.s.z]
+            t_mi = [si.sh_frame.t.x, si.sh_frame.t.y, si.sh_frame.t.z]
+            self.assertAlmostEqual(sum(a * e for a, e in zip(s_mi, t)), -1.0, places=5)
+            self.assertAlmostEqual(sum(a * e for a, e in zip(t_mi, b)), 1.0, places=5)
+            self.assertGreater(b[1], 0)                                  # up the image: towards +y
+
+    def test_plane_frame_is_wavetraces(self):
+        mi, dr = self.mi, __import__("drjit")
+        shape = {"type": "obj", "filename": os.path.join(ROOT, "scenes", "materials-plane.obj"), "face_normals": True}
+        scene = mi.load_dict({"type": "scene", "p": shape})
+        for o in ([7, 5, 1], [6, 3, -4], [9, 2, 4]):
+            si = scene.ray_intersect(mi.Ray3f(o, dr.normalize(mi.Vector3f(0, -1, 0.1))))
+            self.assertTrue(close([si.n.x, si.n.y, si.n.z], [0, 1, 0], 1e-6))
+            self.assertTrue(close([si.sh_frame.s.x, si.sh_frame.s.y, si.sh_frame.s.z], [-1, 0, 0], 1e-6))
+            self.assertTrue(close([si.sh_frame.t.x, si.sh_frame.t.y, si.sh_frame.t.z], [0, 0, 1], 1e-6))
+
+    def test_wt_roughness_is_the_squared_scaled_green(self):
+        mi, dr = self.mi, __import__("drjit")
+        doc = scene_doc(textures=[{"name": "sq", "type": "checker", "size": 1, "even": [1, 1, 1],
+                                   "odd": [0.2, 0.5, 0.2]}],
+                        materials=[{"name": "c", "type": "conductor", "metal": "gold", "roughness": 0.8,
+                                    "roughness_texture": "sq", "energy_compensation": False,
+                                    "masking": "separable"}],
+                        spheres=[{"center": [0, 0, 0], "radius": 1, "material": "c"}])
+        conv = self.convert(doc)
+        mp.register_python_plugins(mi, dr, conv.python_plugins)
+        b = mi.load_dict(mp.realize(mi, self.bsdf_of(conv, self.shapes(conv, "sphere")[0])["bsdf"]))
+        presets = mp.conductor_presets()
+
+        def plain(alpha):
+            return mi.load_dict({"type": "roughconductor", "distribution": "ggx", "alpha": alpha,
+                                 "eta": {"type": "rgb", "value": list(presets["gold"][0])},
+                                 "k": {"type": "rgb", "value": list(presets["gold"][1])}})
+
+        si = dr.zeros(mi.SurfaceInteraction3f)
+        si.sh_frame = mi.Frame3f([0, 0, 1])
+        si.wi = dr.normalize(mi.Vector3f(0.3, 0.1, 0.9))
+        wo = dr.normalize(mi.Vector3f(-0.4, 0.2, 0.8))
+        for p, g in (([0.5, 0, 0.5], 1.0), ([1.5, 0, 0.5], 0.5)):       # even, odd squares (the sphere at 0)
+            si.p = mi.Point3f(p)
+            want = plain((0.8 * g) ** 2).eval(mi.BSDFContext(), si, wo)
+            got = b.eval(mi.BSDFContext(), si, wo)
+            for k in range(3):
+                self.assertAlmostEqual(got[k] / want[k], 1.0, places=5)
+
+    def test_green_mean_of_an_image(self):
+        import make_normal_map as mn
+        path = os.path.join(ROOT, "scenes", "textures", "bumps_normal.png")
+        _, _, rows = mn.read_png(path)
+        want = sum(row[k] for row in rows for k in range(1, len(row), 3)) / 255.0 / (mn.SIZE * mn.SIZE)
+        self.assertAlmostEqual(mp.green_mean(self.mi, path, False), want, places=5)
+        alpha = mp.realize(self.mi, {"__green_mean__": {"file": path, "srgb": False, "scale": 0.25, "power": 2.0}})
+        self.assertAlmostEqual(alpha, 0.25 * want * want, places=5)
+
     def test_material_scenes_load(self):
         mi = self.mi
         for stem in ("materials", "materials-single", "cornell-materials", "cornell-materials-single"):
@@ -833,6 +1091,14 @@ class EmittedPluginsTest(Base):
             conv = mp.convert(os.path.join(ROOT, "scenes", name + ".json"))
             extra = set(conv.plugins()) - set(mp.EMITTED_PLUGINS) - set(mp.PYTHON_PLUGINS)
             self.assertEqual(extra, set(), name)
+
+    def test_peer_pack_keeps_every_emitted_plugin(self):
+        # scripts/peer-pack.sh's PLUGINS: what the trimmed package keeps ("scene" is
+        # libmitsuba's; an "rgb" value loads the srgb plugin).
+        import re
+        with open(os.path.join(ROOT, "scripts", "peer-pack.sh")) as f:
+            kept = set(re.search(r'^PLUGINS="([^"]*)"', f.read(), re.M).group(1).split())
+        self.assertEqual(set(mp.EMITTED_PLUGINS) - kept - {"scene", "rgb"}, set())
 
 
 if __name__ == "__main__":

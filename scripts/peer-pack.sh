@@ -33,7 +33,7 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
 # "scene" is part of libmitsuba.
 PLUGINS="area bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
-obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
+normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
 srgb thindielectric thinlens twosided uniform"
 
 py_local=$(command -v python3)

@@ -11,9 +11,12 @@ right; the rows, top (far) to bottom (near):
     gold, silver, copper, aluminium, iron, chromium   `conductor`, `metal` presets
     glass                                             `glass`, ior 1.5
     plastic                                           `plastic`, albedo (0.8, 0.2, 0.1), ior 1.5
-    thin glass | brushed aluminium | f0 conductor     a `thin` glass sphere (roughness 0); `conductor`
-                                                      aluminium, roughness 0.5, anisotropy 1;
-                                                      `conductor`, f0 (0.96, 0.74, 0.64), roughness 0.25
+    thin glass | brushed aluminium |                  a `thin` glass sphere (roughness 0); `conductor`
+      checker-rough gold | f0 conductor               aluminium, roughness 0.5, anisotropy 1;
+                                                      `conductor` gold, roughness 0.5 times a
+                                                      `roughness_texture` (a checker of 0.25: 1 and
+                                                      0.2, so 0.5 and 0.1); `conductor`, f0 (0.96,
+                                                      0.74, 0.64), roughness 0.25
 
 Every sphere has radius 0.5 and rests on the ground (its centre 1000.5 from the
 ground's). Columns are 1.5 apart, rows 2: far enough that no sphere stands in
@@ -25,6 +28,19 @@ near rows larger), none hiding any part of another. At that size no two
 spheres' pixel bounding boxes meet and none leaves the image, so each sphere's
 pixels can be masked by its box: the script checks this and stops otherwise.
 64 spp, depth 16, roulette from bounce 5.
+
+Left of the table (+x) lies a normal-mapped plane: a 4 x 10 quad on y = 0,
+x in [5.5, 9.5], z in [-5, 5] (above the ground sphere everywhere: the ground
+is 0.015 and more below it), facing up, written as materials-plane.obj (two
+triangles, UVs, no normals, no MTL) beside the scene. Its material is
+`plastic`, albedo (0.25, 0.45, 0.7), roughness 0.3, with "normal_texture"
+textures/bumps_normal.png (tools/make_normal_map.py; "colorspace": "linear",
+"wrap": "repeat"). The UVs tile the map every 2 units (u 0 to 2, v 0 to 5):
+u runs along -x (the image's right) and OBJ's v along +z (up the image), so
+the map lies the way up it was drawn, seen from above, and the UV frame is
+right-handed (the tangent dp/du, the bitangent cross(n, dp/du) up the
+image: wavetrace's and Mitsuba's tangent frames agree there). Its projection
+meets no sphere's box either, which the script checks too.
 
 materials.json has wavetrace's defaults: height-correlated Smith masking, and
 rough conductors and glass energy-compensated. materials-single.json is the
@@ -52,7 +68,10 @@ pixel of its projected centre and two pixel boxes [x0, y0, x1, y1] (x1 and y1
 exclusive, row 0 at the top as in wavetrace's images): `bbox`, every pixel the
 sphere's silhouette touches (computed exactly, from the planes through the eye
 that touch the sphere), and `inner`, a box of pixels wholly inside the
-silhouette, for per-sphere means that take nothing of the ground.
+silhouette, for per-sphere means that take nothing of the ground. `planes`
+does the same for the plane (its instance's index, material, corners, the
+pixel of its centre, `bbox` and `inner`: the projected quad is convex, so a
+box whose corners see the quad lies inside it).
 """
 
 import argparse
@@ -77,6 +96,8 @@ LAST_ROW = [
     ({"name": "brushed-aluminium", "type": "conductor", "metal": "aluminium", "roughness": 0.5,
       "anisotropy": 1}, 0.0),
     ({"name": "f0-conductor", "type": "conductor", "f0": [0.96, 0.74, 0.64], "roughness": 0.25}, 2.0),
+    ({"name": "checker-rough-gold", "type": "conductor", "metal": "gold", "roughness": 0.5,
+      "roughness_texture": "roughness-checker"}, 1.0),   # last: the spheres before keep their indices
 ]
 
 RADIUS = 0.5
@@ -90,6 +111,24 @@ ELEVATION = 45.0     # degrees above the ground
 DISTANCE = 55.0
 VFOV = 13.5
 WIDTH, HEIGHT = 1920, 1080
+
+# The textures: the ground's, the checker that scales checker-rough-gold's
+# roughness (its green channel: 1 and 0.2) and the plane's normal map.
+TEXTURES = [
+    {"name": "tiles", "type": "checker", "size": 0.5, "even": [0.75, 0.75, 0.72], "odd": [0.35, 0.35, 0.33]},
+    {"name": "roughness-checker", "type": "checker", "size": 0.25, "even": [1, 1, 1], "odd": [0.2, 0.2, 0.2]},
+    {"name": "bumps", "type": "image", "file": "textures/bumps_normal.png", "colorspace": "linear",
+     "wrap": "repeat"},
+]
+
+# The normal-mapped plane: x0..x1 by z0..z1 on y = 0, facing up; its UVs repeat
+# the map every PLANE_TILE units.
+PLANE_STEM = "materials-plane"
+PLANE_X = (5.5, 9.5)
+PLANE_Z = (-5.0, 5.0)
+PLANE_TILE = 2.0
+PLANE_MATERIAL = {"name": "bumpy-plastic", "type": "plastic", "albedo": [0.25, 0.45, 0.7], "ior": IOR,
+                  "roughness": 0.3, "normal_texture": "bumps"}
 
 
 def rows():
@@ -130,6 +169,25 @@ def mitsuba_model(material):
     return m
 
 
+def plane_corners():
+    """The plane's corners (x, y, z) and their OBJ UVs, counter-clockwise seen
+    from above: u grows along -x, OBJ's v along +z."""
+    (x0, x1), (z0, z1) = PLANE_X, PLANE_Z
+    corners = [(x1, 0.0, z0), (x0, 0.0, z0), (x0, 0.0, z1), (x1, 0.0, z1)]
+    uvs = [((x1 - x) / PLANE_TILE, (z - z0) / PLANE_TILE) for x, _, z in corners]
+    return corners, uvs
+
+
+def write_plane(folder):
+    """materials-plane.obj: the plane as two triangles with UVs. Returns its name."""
+    corners, uvs = plane_corners()
+    name = PLANE_STEM + ".obj"
+    meshfile.write_obj(os.path.join(folder, name), corners, [(0, 1, 2), (0, 2, 3)], uvs=uvs,
+                       header="the normal-mapped plane of materials.json (its material is the scene's): "
+                              "y = 0, facing +y,\nUVs tiling every %g units; tools/make_materials.py" % PLANE_TILE)
+    return name
+
+
 def build_table(single=False):
     """materials.json, or (single) materials-single.json."""
     materials = [{"name": "ground", "type": "lambertian", "albedo": [1, 1, 1], "texture": "tiles"}]
@@ -141,15 +199,17 @@ def build_table(single=False):
             materials.append(mitsuba_model(m) if single else m)
             spheres.append({"center": [round(v, 6) for v in on_ground(-offset * COLUMN_PITCH, z)],
                             "radius": RADIUS, "material": m["name"]})
+    materials.append(mitsuba_model(PLANE_MATERIAL) if single else dict(PLANE_MATERIAL))
     return {
         "camera": camera(),
         "sky": {"type": "environment", "file": "textures/sky_sun.hdr", "mapping": "latlong", "rotation": 0,
                 "intensity": 1},
         "render": {"width": WIDTH, "height": HEIGHT, "spp": 64, "depth": 16, "roulette_depth": 5, "seed": 1},
-        "textures": [{"name": "tiles", "type": "checker", "size": 0.5, "even": [0.75, 0.75, 0.72],
-                      "odd": [0.35, 0.35, 0.33]}],
+        "textures": [dict(t) for t in TEXTURES],
         "materials": materials,
         "spheres": spheres,
+        "meshes": [{"name": "plane", "file": PLANE_STEM + ".obj", "material": PLANE_MATERIAL["name"]}],
+        "instances": [{"mesh": "plane", "translate": [0, 0, 0]}],
     }
 
 
@@ -226,9 +286,10 @@ class Projection:
                 (0.5 + tx1 / (2 * self.half_w)) * self.width, (0.5 - ty0 / (2 * self.half_h)) * self.height)
 
 
-def inner_box(proj, center, radius, ext):
+def inner_box(sees, ext):
     """The largest box of whole pixels, centred in the silhouette's bounding box,
-    whose four corners (and so, the silhouette being convex, all of it) lie inside."""
+    whose four corners (and so, the silhouette being convex, all of it) lie
+    inside. sees(px, py): whether image point (px, py) is inside."""
     cx, cy = 0.5 * (ext[0] + ext[2]), 0.5 * (ext[1] + ext[3])
     hx, hy = 0.5 * (ext[2] - ext[0]), 0.5 * (ext[3] - ext[1])
     best = None
@@ -237,7 +298,7 @@ def inner_box(proj, center, radius, ext):
         s = 0.5 * (lo + hi)
         box = (math.ceil(cx - s * hx), math.ceil(cy - s * hy), math.floor(cx + s * hx), math.floor(cy + s * hy))
         corners = [(box[0], box[1]), (box[2], box[1]), (box[0], box[3]), (box[2], box[3])]
-        if box[2] > box[0] and box[3] > box[1] and all(proj.sees(px, py, center, radius) for px, py in corners):
+        if box[2] > box[0] and box[3] > box[1] and all(sees(px, py) for px, py in corners):
             best, lo = box, s
         else:
             hi = s
@@ -263,12 +324,48 @@ def regions(scene, width, height):
         out.append({"index": index, "material": s["material"], "row": labels[s["material"]], "type": m["type"],
                     "roughness": m.get("roughness", 0), "center": s["center"], "radius": s["radius"],
                     "center_px": [round(cx, 3), round(cy, 3)], "bbox": bbox,
-                    "inner": inner_box(proj, s["center"], s["radius"], ext)})
+                    "inner": inner_box(lambda px, py: proj.sees(px, py, s["center"], s["radius"]), ext)})
+    return out
+
+
+def plane_regions(scene, width, height):
+    """The plane (each instance of the mesh PLANE_STEM.obj): where it lands in a
+    width x height image."""
+    proj = Projection(scene["camera"], width, height)
+    corners, _ = plane_corners()
+    (x0, x1), (z0, z1) = PLANE_X, PLANE_Z
+
+    def sees(px, py):
+        d = proj.ray(px, py)
+        if d[1] >= 0:
+            return False
+        t = -proj.origin[1] / d[1]
+        x, z = proj.origin[0] + t * d[0], proj.origin[2] + t * d[2]
+        return x0 <= x <= x1 and z0 <= z <= z1
+
+    meshes = {m["name"]: m for m in scene.get("meshes", [])}
+    out = []
+    for index, inst in enumerate(scene.get("instances", [])):
+        mesh = meshes[inst["mesh"]]
+        if mesh["file"] != PLANE_STEM + ".obj":
+            continue
+        material = inst.get("material", mesh.get("material"))
+        m = next(m for m in scene["materials"] if m["name"] == material)
+        pixels = [proj.pixel(c) for c in corners]
+        ext = (min(p[0] for p in pixels), min(p[1] for p in pixels), max(p[0] for p in pixels),
+               max(p[1] for p in pixels))
+        bbox = [max(0, math.floor(ext[0])), max(0, math.floor(ext[1])),
+                min(width, math.ceil(ext[2])), min(height, math.ceil(ext[3]))]
+        cx, cy = proj.pixel([0.5 * (x0 + x1), 0.0, 0.5 * (z0 + z1)])
+        out.append({"instance": index, "mesh": inst["mesh"], "material": material, "type": m["type"],
+                    "roughness": m.get("roughness", 0), "corners": [list(c) for c in corners],
+                    "center_px": [round(cx, 3), round(cy, 3)], "bbox": bbox, "inner": inner_box(sees, ext)})
     return out
 
 
 def overlapping(regs, width, height):
-    """Pairs of spheres whose boxes meet, and spheres whose box leaves the image."""
+    """Pairs of regions (spheres, the plane) whose boxes meet, and regions whose
+    box leaves the image."""
     problems = []
     for r in regs:
         ext = r["bbox"]
@@ -359,30 +456,32 @@ def main():
     args = ap.parse_args()
     folder = args.dir
     table = build_table()
-    problems = overlapping(regions(table, WIDTH, HEIGHT), WIDTH, HEIGHT)
+    problems = overlapping(regions(table, WIDTH, HEIGHT) + plane_regions(table, WIDTH, HEIGHT), WIDTH, HEIGHT)
     if problems:
-        sys.exit("make_materials: at %d x %d, sphere boxes overlap or leave the image: %s"
+        sys.exit("make_materials: at %d x %d, sphere or plane boxes overlap or leave the image: %s"
                  % (WIDTH, HEIGHT, "; ".join(problems)))
     write(os.path.join(folder, "materials.json"), table)
     write(os.path.join(folder, "materials-single.json"), build_table(single=True))
+    plane = write_plane(folder)
     names, mtl = write_cornell_meshes(folder)
     write(os.path.join(folder, CORNELL_STEM + ".json"), build_cornell(names))
     write(os.path.join(folder, CORNELL_STEM + "-single.json"), build_cornell(names, single=True))
     counts = scenefile.counts_text(scenefile.spheres_by(table, lambda m: m["type"]))
     log = sys.stderr if args.regions == "-" else sys.stdout   # stdout may be the regions
-    print("%s: %d spheres (%s), and materials-single.json" % (os.path.normpath(os.path.join(folder, "materials.json")),
-                                                              len(table["spheres"]), counts), file=log)
+    print("%s: %d spheres (%s), a plane (%s), and materials-single.json"
+          % (os.path.normpath(os.path.join(folder, "materials.json")), len(table["spheres"]), counts, plane), file=log)
     print("%s: + %s, %s, %s, %s, and %s-single.json" % (
         os.path.normpath(os.path.join(folder, CORNELL_STEM + ".json")), names["room"], mtl, names["short_block"],
         names["tall_block"], CORNELL_STEM), file=log)
     if args.regions:
         regs = regions(table, args.width, args.height)
-        problems = overlapping(regs, args.width, args.height)
+        planes = plane_regions(table, args.width, args.height)
+        problems = overlapping(regs + planes, args.width, args.height)
         if problems:
             print("make_materials: warning: at %d x %d, boxes overlap or leave the image: %s"
                   % (args.width, args.height, "; ".join(problems)), file=sys.stderr)
         text = scenefile.dumps_scene({"scene": "materials.json", "width": args.width, "height": args.height,
-                                      "spheres": regs})
+                                      "spheres": regs, "planes": planes})
         if args.regions == "-":
             sys.stdout.write(text)
         else:

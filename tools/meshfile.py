@@ -229,16 +229,23 @@ def check_glb(path):
     return triangles, vertices
 
 
-def write_obj(path, positions, faces, mtllib=None, groups=None, header=None):
+def write_obj(path, positions, faces, mtllib=None, groups=None, header=None, uvs=None):
     """A small OBJ: POSITIONS a list of (x, y, z); FACES a list of index
     triples (0-based), or GROUPS a list of (group name, material name or None,
-    faces). Numbers are written with %g (at most 6 significant digits)."""
+    faces). UVS: None, or a (u, v) per position (OBJ's v: 0 at the image's
+    bottom row), which the faces index as they index the positions. Numbers
+    are written with %g (at most 6 significant digits)."""
     lines = []
     if header:
         lines += ["# " + h for h in header.splitlines()]
     if mtllib:
         lines.append("mtllib " + mtllib)
     lines += ["v %g %g %g" % tuple(p) for p in positions]
+    if uvs is not None:
+        if len(uvs) != len(positions):
+            raise ValueError("write_obj: %d UVs for %d positions" % (len(uvs), len(positions)))
+        lines += ["vt %g %g" % tuple(t) for t in uvs]
+    corner = "%d/%d" if uvs is not None else "%d"
     if groups is None:
         groups = [(None, None, faces)]
     for name, material, fs in groups:
@@ -246,7 +253,7 @@ def write_obj(path, positions, faces, mtllib=None, groups=None, header=None):
             lines.append("o " + name)
         if material:
             lines.append("usemtl " + material)
-        lines += ["f %d %d %d" % (a + 1, b + 1, c + 1) for a, b, c in fs]
+        lines += ["f " + " ".join(corner % ((i + 1,) * corner.count("%")) for i in f) for f in fs]
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
 
