@@ -55,6 +55,26 @@ WT_HD WT_INLINE int wrap_index(int i, int n, Wrap w) {
   return 0;
 }
 
+// The two taps i0 and i1 = i0 + 1 of a coordinate wrap_coordinate reduced, scaled
+// to n texels (so i0 >= -1, and i1 <= n, or 2n where mirrored): repeat and clamp
+// need one test each, as the study's lookup had.
+WT_HD WT_INLINE void wrap_taps(int& i0, int& i1, int n, Wrap w) {
+  switch (w) {
+    case Wrap::Repeat:
+      i0 = i0 < 0 ? i0 + n : i0;
+      i1 = i1 >= n ? i1 - n : i1;
+      return;
+    case Wrap::Clamp:
+      i0 = i0 < 0 ? 0 : i0;
+      i1 = i1 >= n ? n - 1 : i1;
+      return;
+    case Wrap::Mirror:
+      i0 = wrap_index(i0, n, w);
+      i1 = wrap_index(i1, n, w);
+      return;
+  }
+}
+
 // The coordinate reduced before it is scaled to texels: repeat keeps its fraction
 // (so large coordinates keep their precision), clamp clamps it to [0, 1], mirror
 // reduces it modulo 2.
@@ -95,10 +115,8 @@ WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v, Wrap wr
   float ax = x - fx, ay = y - fy;
   int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   int x1 = x0 + 1, y1 = y0 + 1;
-  x0 = wrap_index(x0, im.width, wrap_u);
-  x1 = wrap_index(x1, im.width, wrap_u);
-  y0 = wrap_index(y0, im.height, wrap_v);
-  y1 = wrap_index(y1, im.height, wrap_v);
+  wrap_taps(x0, x1, im.width, wrap_u);
+  wrap_taps(y0, y1, im.height, wrap_v);
   vec3 top = (1.0f - ax) * image_texel(im, x0, y0) + ax * image_texel(im, x1, y0);
   vec3 bottom = (1.0f - ax) * image_texel(im, x0, y1) + ax * image_texel(im, x1, y1);
   return (1.0f - ay) * top + ay * bottom;

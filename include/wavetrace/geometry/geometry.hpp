@@ -203,7 +203,9 @@ WT_HD WT_INLINE uint32_t material_index(const Geometry& g, const Hit& hit) {
 // and the shading normal and UVs where the mesh has them. The geometric normal is
 // turned to the shading normal's side, so that "outward" is what the mesh's normals
 // say it is whatever the winding.
-template <class Geometry>
+// Tangents: with the tangent frame's dp/du, dp/dv and handedness (what normal maps and
+// anisotropy need: kernels with kMicrofacet), or without (dpdu the first edge).
+template <bool Tangents = true, class Geometry>
 WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance& in, const Ray& ray, const Hit& hit) {
   const TriangleGeom tri = g.triangle(hit.prim);
   SurfacePoint sp;
@@ -239,19 +241,27 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
     const vec2 t0 = g.uv(sh.vertex[0]), t1 = g.uv(sh.vertex[1]), t2 = g.uv(sh.vertex[2]);
     sp.uv = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
     // dp/du and dp/dv from p(u, v) over the triangle: solve the UV deltas of the two edges.
-    const vec2 d1 = t1 - t0, d2 = t2 - t0;
-    const float det = d1.x * d2.y - d1.y * d2.x;
-    if (det != 0.0f) {
-      const float inv = 1.0f / det;
-      dpdu = (d2.y * e1 - d1.y * e2) * inv;
-      dpdv = (d1.x * e2 - d2.x * e1) * inv;
+    if constexpr (Tangents) {
+      const vec2 d1 = t1 - t0, d2 = t2 - t0;
+      const float det = d1.x * d2.y - d1.y * d2.x;
+      if (det != 0.0f) {
+        const float inv = 1.0f / det;
+        dpdu = (d2.y * e1 - d1.y * e2) * inv;
+        dpdv = (d1.x * e2 - d2.x * e1) * inv;
+      }
     }
   } else {
     sp.uv = vec2(hit.b1, hit.b2);
   }
-  sp.dpdu = in.identity ? dpdu : in.world_from_object.vector(dpdu);
-  if (!in.identity) dpdv = in.world_from_object.vector(dpdv);
-  sp.tangent_sign = glm::dot(glm::cross(sp.n, sp.dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
+  sp.dpdu = dpdu;
+  sp.tangent_sign = 1.0f;
+  if constexpr (Tangents) {
+    if (!in.identity) {
+      sp.dpdu = in.world_from_object.vector(dpdu);
+      dpdv = in.world_from_object.vector(dpdv);
+    }
+    sp.tangent_sign = glm::dot(glm::cross(sp.n, sp.dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
+  }
   sp.has_uv = true;
   sp.front = glm::dot(ray.dir, sp.ng) < 0.0f;
   // The point's error along the normal, and the rounding of adding the offset to it
@@ -269,7 +279,7 @@ WT_HD WT_INLINE SurfacePoint surface_at(const Geometry& g, const Ray& ray, const
     case PrimitiveKind::Sphere:
       return sphere_surface(g.sphere(hit.prim), ray, hit.t);
     case PrimitiveKind::Triangle:
-      return triangle_surface(g, in, ray, hit);
+      return triangle_surface<(Kinds & kMicrofacet) != 0>(g, in, ray, hit);
   }
   return sphere_surface(g.sphere(hit.prim), ray, hit.t);
 }
