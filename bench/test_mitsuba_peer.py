@@ -816,26 +816,12 @@ class MaterialScenesTest(Base):
             with open(os.path.join(ROOT, "scenes", file)) as f:
                 self.assertEqual(f.read(), scenefile.dumps_scene(scene), file)
 
-    def test_committed_plane_and_normal_map_are_the_generators(self):
+    def test_committed_plane_is_the_generators(self):
         import make_materials as mm
-        import make_normal_map as mn
         mm.write_plane(self.tmp)
         for name in (mm.PLANE_STEM + ".obj",):
             with open(os.path.join(self.tmp, name)) as a, open(os.path.join(ROOT, "scenes", name)) as b:
                 self.assertEqual(a.read(), b.read(), name)
-        # The pixels (the bytes depend on zlib's version as well).
-        w, h, rows = mn.read_png(os.path.join(ROOT, "scenes", "textures", "bumps_normal.png"))
-        self.assertEqual((w, h), (mn.SIZE, mn.SIZE))
-        self.assertEqual(rows, mn.normal_map())
-        self.assertEqual(rows[0][:3], bytes((128, 128, 255)))            # flat between the bumps
-        # It tiles: the first column continues the last, the first row the last.
-        for a, b in ((rows[0], rows[-1]), (rows[100][:3], rows[100][-3:])):
-            self.assertTrue(all(abs(x - y) <= 12 for x, y in zip(a, b)))
-        # OpenGL's convention: above a bump's centre the normal leans up the image
-        # (green > 0.5), right of it towards +u (red > 0.5).
-        cx, cy = [int(v) for v in mn.bump_centres()[0]]
-        self.assertGreater(rows[cy - 13][3 * cx + 1], 200)
-        self.assertGreater(rows[cy][3 * (cx + 13)], 200)
 
     def test_plane_faces_up_with_a_right_handed_uv_frame(self):
         # wavetrace's tangent_sign (geometry.hpp) is +1 where cross(n, dp/du) runs
@@ -944,22 +930,29 @@ class MitsubaModelTest(Base):
         mi.set_variant("scalar_rgb")
         self.mi = mi
 
-    def test_sphere_tangent_is_wavetraces_azimuth(self):
-        # Anisotropic alpha_u runs along Mitsuba's sh_frame.s (dp/du); wavetrace's
-        # alpha_x along a sphere's dp/du = (-n.z, 0, n.x): the same axis.
+    def sphere_frames(self):
+        """(Mitsuba's shading frame (s, t), wavetrace's unit tangent T, the normal n)
+        at three hits of a sphere placed as the converter places one."""
         mi, dr = self.mi, __import__("drjit")
         c, r = [1.0, 2.0, 3.0], 0.7
         to_world = mp.mat_mul(mp.mat_mul(mp.mat_translate(c), mp.SPHERE_FRAME), mp.mat_scale(r))
         sphere = {"type": "sphere", "to_world": mp.realize(mi, mp.transform(to_world))}
         scene = mi.load_dict({"type": "scene", "s": sphere})
+        out = []
         for d in ([0.3, -0.2, 1.0], [-0.5, 0.4, 1.0], [0.1, 0.6, -1.0]):
-            o = [c[i] - 5 * d[i] for i in range(3)]
-            si = scene.ray_intersect(mi.Ray3f(o, dr.normalize(mi.Vector3f(d))))
+            si = scene.ray_intersect(mi.Ray3f([c[i] - 5 * d[i] for i in range(3)], dr.normalize(mi.Vector3f(d))))
             n = [si.n.x, si.n.y, si.n.z]
             t = [-n[2], 0.0, n[0]]
             ln = math.sqrt(sum(x * x for x in t))
-            s = [si.sh_frame.s.x, si.sh_frame.s.y, si.sh_frame.s.z]
-            self.assertAlmostEqual(abs(sum(a * b / ln for a, b in zip(s, t))), 1.0, places=5)
+            out.append(([si.sh_frame.s.x, si.sh_frame.s.y, si.sh_frame.s.z],
+                        [si.sh_frame.t.x, si.sh_frame.t.y, si.sh_frame.t.z], [x / ln for x in t], n))
+        return out
+
+    def test_sphere_tangent_is_wavetraces_azimuth(self):
+        # Anisotropic alpha_u runs along Mitsuba's sh_frame.s (dp/du); wavetrace's
+        # alpha_x along a sphere's dp/du = (-n.z, 0, n.x): the same axis.
+        for s, _, t, _ in self.sphere_frames():
+            self.assertAlmostEqual(abs(sum(a * b for a, b in zip(s, t))), 1.0, places=5)
 
     def test_principled_metallic_is_schlick_ggx(self):
         mi, dr = self.mi, __import__("drjit")
@@ -1009,20 +1002,8 @@ class MitsubaModelTest(Base):
         # The normal-map note: on a sphere Mitsuba's s is wavetrace's -T (T the
         # azimuth, dp/du = (-n.z, 0, n.x)) and its t = cross(n, s) is wavetrace's
         # bitangent cross(n, T) x tangent_sign (-1 on spheres, sphere.hpp).
-        mi, dr = self.mi, __import__("drjit")
-        c, r = [1.0, 2.0, 3.0], 0.7
-        to_world = mp.mat_mul(mp.mat_mul(mp.mat_translate(c), mp.SPHERE_FRAME), mp.mat_scale(r))
-        sphere = {"type": "sphere", "to_world": mp.realize(mi, mp.transform(to_world))}
-        scene = mi.load_dict({"type": "scene", "s": sphere})
-        for d in ([0.3, -0.2, 1.0], [-0.5, 0.4, 1.0], [0.1, 0.6, -1.0]):
-            si = scene.ray_intersect(mi.Ray3f([c[i] - 5 * d[i] for i in range(3)], dr.normalize(mi.Vector3f(d))))
-            n = [si.n.x, si.n.y, si.n.z]
-            t = [-n[2], 0.0, n[0]]
-            ln = math.sqrt(sum(x * x for x in t))
-            t = [x / ln for x in t]
+        for s_mi, t_mi, t, n in self.sphere_frames():
             b = [-(n[1] * t[2] - n[2] * t[1]), -(n[2] * t[0] - n[0] * t[2]), -(n[0] * t[1] - n[1] * t[0])]
-            s_mi = [si.sh_frame.s.x, si.sh_frame.s.y, si.sh_frame.s.z]
-            t_mi = [si.sh_frame.t.x, si.sh_frame.t.y, si.sh_frame.t.z]
             self.assertAlmostEqual(sum(a * e for a, e in zip(s_mi, t)), -1.0, places=5)
             self.assertAlmostEqual(sum(a * e for a, e in zip(t_mi, b)), 1.0, places=5)
             self.assertGreater(b[1], 0)                                  # up the image: towards +y
@@ -1066,11 +1047,26 @@ class MitsubaModelTest(Base):
             for k in range(3):
                 self.assertAlmostEqual(got[k] / want[k], 1.0, places=5)
 
-    def test_green_mean_of_an_image(self):
-        import make_normal_map as mn
+    def bumps_normal(self):
+        import numpy as np
         path = os.path.join(ROOT, "scenes", "textures", "bumps_normal.png")
-        _, _, rows = mn.read_png(path)
-        want = sum(row[k] for row in rows for k in range(1, len(row), 3)) / 255.0 / (mn.SIZE * mn.SIZE)
+        return path, np.array(self.mi.Bitmap(path), dtype=np.int32)
+
+    def test_normal_map_is_opengls_convention(self):
+        # tools/make_textures.cpp's bumps: flat between them, tiling both ways, and
+        # above a bump's centre (texel 32, 32) the normal leans up the image (green
+        # high), right of it towards +u (red high).
+        _, img = self.bumps_normal()
+        self.assertEqual(img.shape, (256, 256, 3))
+        self.assertEqual(list(img[0, 0]), [128, 128, 255])
+        self.assertLessEqual(abs(img[0] - img[-1]).max(), 12)
+        self.assertLessEqual(abs(img[:, 0] - img[:, -1]).max(), 12)
+        self.assertGreater(img[32 - 13, 32, 1], 200)
+        self.assertGreater(img[32, 32 + 13, 0], 200)
+
+    def test_green_mean_of_an_image(self):
+        path, img = self.bumps_normal()
+        want = img[:, :, 1].sum() / 255.0 / img[:, :, 1].size
         self.assertAlmostEqual(mp.green_mean(self.mi, path, False), want, places=5)
         alpha = mp.realize(self.mi, {"__green_mean__": {"file": path, "srgb": False, "scale": 0.25, "power": 2.0}})
         self.assertAlmostEqual(alpha, 0.25 * want * want, places=5)

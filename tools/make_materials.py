@@ -34,7 +34,7 @@ x in [5.5, 9.5], z in [-5, 5] (above the ground sphere everywhere: the ground
 is 0.015 and more below it), facing up, written as materials-plane.obj (two
 triangles, UVs, no normals, no MTL) beside the scene. Its material is
 `plastic`, albedo (0.25, 0.45, 0.7), roughness 0.3, with "normal_texture"
-textures/bumps_normal.png (tools/make_normal_map.py; "colorspace": "linear",
+textures/bumps_normal.png (tools/make_textures.cpp; "colorspace": "linear",
 "wrap": "repeat"). The UVs tile the map every 2 units (u 0 to 2, v 0 to 5):
 u runs along -x (the image's right) and OBJ's v along +z (up the image), so
 the map lies the way up it was drawn, seen from above, and the UV frame is

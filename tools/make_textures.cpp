@@ -385,6 +385,46 @@ bool write_hdr(const std::filesystem::path& path, int width, int height, const s
   return true;
 }
 
+// bumps_normal.png: a tileable tangent-space normal map of round bumps, 256 x 256,
+// the normal n stored as n / 2 + 1/2 (flat is (128, 128, 255)), in the OpenGL and
+// glTF convention wavetrace's normal_texture reads (docs/scene-format.md): +x
+// (red) along +u, +y (green) up the image, +z (blue) out of the surface; read it
+// with "colorspace": "linear". Sixteen bumps in four rows of four, one every 64
+// texels, every other row shifted by half a bump, so that the image tiles both
+// ways. A bump of radius R = 26 texels has the height h(r) = H (1 - (r/R)^2)^2,
+// H = 0.6 R: level at its top and at its rim, steepest (43 degrees) at R / sqrt(3).
+// The normal (-dh/dx, dh/drow, 1), normalized, is evaluated analytically at each
+// texel's centre, so nothing is sampled and nothing aliases.
+Image8 make_bumps_normal() {
+  constexpr int kSize = 256, kPitch = 64;
+  constexpr double kRadius = 26.0, kHeight = 0.6 * kRadius;
+  Image8 img(kSize, kSize);
+  for (int row = 0; row < kSize; ++row) {
+    for (int col = 0; col < kSize; ++col) {
+      const double x = col + 0.5, y = row + 0.5;
+      double gx = 0.0, gy = 0.0;
+      for (int j = 0; j < kSize / kPitch; ++j) {
+        for (int i = 0; i < kSize / kPitch; ++i) {
+          const double cx = std::fmod((i + 0.5 + 0.5 * (j % 2)) * kPitch, kSize), cy = (j + 0.5) * kPitch;
+          // The nearest copy of the bump on the torus.
+          const double dx = std::fmod(x - cx + 1.5 * kSize, kSize) - 0.5 * kSize;
+          const double dy = std::fmod(y - cy + 1.5 * kSize, kSize) - 0.5 * kSize;
+          const double s = (dx * dx + dy * dy) / (kRadius * kRadius);
+          if (s < 1.0) {
+            const double k = -4.0 * kHeight * (1.0 - s) / (kRadius * kRadius);  // dh/dx = k dx
+            gx += k * dx;
+            gy += k * dy;
+          }
+        }
+      }
+      // Up the image is -row: n.y = dh/drow.
+      const vec3 n = glm::normalize(vec3(static_cast<float>(-gx), static_cast<float>(gy), 1.0f));
+      img.set(col, row, 0.5f * n + vec3(0.5f));
+    }
+  }
+  return img;
+}
+
 bool write_png(const std::filesystem::path& path, const Image8& img) {
   if (!stbi_write_png(path.string().c_str(), img.width, img.height, 3, img.rgb.data(), img.width * 3)) {
     std::fprintf(stderr, "wavetrace-textures: cannot write %s\n", path.string().c_str());
@@ -423,6 +463,7 @@ int main(int argc, char** argv) {
   bool ok = true;
   for (const auto& p : probes) ok = write_png(out / p.file, make_probe(p.env, kProbe)) && ok;
   ok = write_png(out / "planet.png", make_planet(756, 378)) && ok;
+  ok = write_png(out / "bumps_normal.png", make_bumps_normal()) && ok;
   ok = write_hdr(out / "sky_sun.hdr", 512, 256, make_sky(512, 256)) && ok;
   return ok ? 0 : 1;
 }
