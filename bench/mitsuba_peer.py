@@ -927,6 +927,16 @@ class Converter:
                 return True
         return False
 
+    def texture_of(self, m, key):
+        """The texture the material's KEY names (None where it names none)."""
+        name = m.get(key)
+        if name is None:
+            return None
+        t = self.textures.get(name)
+        if t is None:
+            raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
+        return t
+
     @staticmethod
     def roughness_of(m):
         """A microfacet material's roughness: 1 by default where a roughness
@@ -940,12 +950,10 @@ class Converter:
         the Mitsuba parameter takes a texture and the pattern converts; else one
         number, from the texture's mean green (noted). VALUE where the material
         has no roughness texture."""
-        name = m.get("roughness_texture")
-        if name is None:
-            return value
-        t = self.textures.get(name)
+        t = self.texture_of(m, "roughness_texture")
         if t is None:
-            raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
+            return value
+        name = m["roughness_texture"]
         if takes_texture and self.allow_python and t["type"] in ("checker", "image"):
             self.python_plugins.add("wt_roughness")
             return {"type": "wt_roughness", "texture": self._texture(t, [1, 1, 1], on_sphere, to_object),
@@ -981,12 +989,10 @@ class Converter:
         that converts (an image): the map perturbs the shading frame of the BSDF
         inside, twosided included, so that a surface's back sees the map turned
         with it, as in wavetrace."""
-        name = m.get("normal_texture")
-        if name is None:
-            return b
-        t = self.textures.get(name)
+        t = self.texture_of(m, "normal_texture")
         if t is None:
-            raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
+            return b
+        name = m["normal_texture"]
         strength = float(m.get("normal_strength", 1.0))
         if strength == 0:
             return b   # the unperturbed normal, in wavetrace too
