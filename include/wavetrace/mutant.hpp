@@ -28,7 +28,10 @@ namespace wt {
   X(TextureVFlipped, "texture-v-flipped")         /* image textures on surfaces */               \
   X(RouletteWithoutOneOverQ, "roulette-without-1/q")                                           \
   X(EnvironmentRowShifted, "environment-row-shifted") /* sampled one row off its density */      \
-  X(ShadowIgnoresFirstHit, "shadow-ignores-first-hit")
+  X(ShadowIgnoresFirstHit, "shadow-ignores-first-hit")                                        \
+  X(VisibleNormalsWithoutG1, "visible-normals-without-g1") /* GGX's density of visible normals */ \
+  X(GlassUnscaledRadiance, "glass-unscaled-radiance") /* rough transmission without 1 / eta^2 */ \
+  X(CompensationDropped, "compensation-dropped")  /* conductors' multiple-scattering lobe */
 
 enum class Mutant : int {
   None,

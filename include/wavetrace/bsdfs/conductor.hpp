@@ -44,7 +44,7 @@ WT_HD WT_INLINE vec3 conductor_eval_local(const BsdfAt& b, const Ggx& g, const v
   if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
   const vec3 h = glm::normalize(wo + wi);
   vec3 f = conductor_fresnel(b, glm::dot(wo, h)) * (g.d(h) * g.g2(wo, wi) / (4.0f * wo.z));
-  if (conductor_compensated(b)) {
+  if (conductor_compensated(b) && !WT_MUTANT(CompensationDropped)) {
     const float* t = b.tables + b.p.table;
     const float r = table_roughness(g);
     f += conductor_multiple_scale(b.p.fresnel_average, conductor_average_energy(t, r)) *

@@ -57,7 +57,8 @@ WT_HD WT_INLINE vec3 glass_eval_local(const BsdfAt& b, const Ggx& g, const vec3&
   const float denom = hi + ho / eta;
   const float jacobian = fabsf(hi) / (denom * denom);
   pdf = visible * (1.0f - f_r) * jacobian;
-  return b.albedo * ((1.0f - f_r) * dg * fabsf(ho) * jacobian * scale / (fabsf(wo.z) * eta * eta));
+  return b.albedo * ((1.0f - f_r) * dg * fabsf(ho) * jacobian * scale /
+                     (WT_MUTANT(GlassUnscaledRadiance) ? fabsf(wo.z) : fabsf(wo.z) * eta * eta));
 }
 
 WT_HD WT_INLINE BsdfSample glass_sample_local(const BsdfAt& b, const vec3& wo, const Rng& rng, bool single = false) {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include "wavetrace/bsdfs/common.hpp"
+#include "wavetrace/mutant.hpp"
 
 namespace wt {
 
@@ -47,7 +48,7 @@ struct Ggx {
   WT_HD float visible_d(const vec3& wo, const vec3& h) const {
     const float c = glm::dot(wo, h);
     if (c <= 0.0f || wo.z <= 0.0f) return 0.0f;
-    return g1(wo) * c * d(h) / wo.z;
+    return (WT_MUTANT(VisibleNormalsWithoutG1) ? 1.0f : g1(wo)) * c * d(h) / wo.z;
   }
 
   // A visible normal seen from wo (wo.z > 0), from two uniforms.
