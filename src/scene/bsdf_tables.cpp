@@ -47,17 +47,6 @@ float refracted_weight(const Ggx& g, const vec3& wo, const vec3& h, float eta) {
   return wi.z < 0.0f ? g.g2(wo, wi) / g.g1(wo) : 0.0f;
 }
 
-// 2 int_0^1 table(mu) mu dmu, the table read as the renderer reads it.
-float cosine_average(const float* t) {
-  constexpr int kSteps = 1024;
-  double sum = 0.0;
-  for (int i = 0; i < kSteps; ++i) {
-    const float mu = (i + 0.5f) / kSteps;
-    sum += cosine_table(t, mu) * mu;
-  }
-  return static_cast<float>(2.0 * sum / kSteps);
-}
-
 template <class F>
 double cosine_weighted_mean(F f) {
   constexpr int kSteps = 1024;
@@ -68,6 +57,12 @@ double cosine_weighted_mean(F f) {
   }
   return 2.0 * sum / kSteps;
 }
+
+// 2 int_0^1 table(mu) mu dmu, the table read as the renderer reads it.
+float cosine_average(const float* t) {
+  return static_cast<float>(cosine_weighted_mean([t](float mu) { return cosine_table(t, mu); }));
+}
+
 
 std::vector<float> make_conductor_table(bool separable) {
   std::vector<float> t(kConductorTableFloats);
