@@ -550,6 +550,35 @@ TEST(SceneParser, TruncatedPngTextureSaysItIsCutShort) {
   }
 }
 
+// A BMP whose header claims no rows (which stb decodes into an image of no
+// pixels) is refused, not filtered.
+TEST(SceneParser, AnImageOfNoPixelsIsRefused) {
+  TempDir dir;
+  // 54-byte header: 3 x 0 pixels, 24 bits, uncompressed.
+  std::string bmp(54, '\0');
+  auto put32 = [&](size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) bmp[at + i] = static_cast<char>((v >> (8 * i)) & 255);
+  };
+  bmp[0] = 'B';
+  bmp[1] = 'M';
+  put32(2, 54);
+  put32(10, 54);
+  put32(14, 40);
+  put32(18, 3);
+  put32(22, 0);
+  bmp[26] = 1;
+  bmp[28] = 24;
+  dir.write("empty.bmp", bmp);
+  const std::string scene = dir.write("s.json", image_texture_scene("empty.bmp", "srgb").dump());
+  try {
+    load_scene(scene);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    expect_error(e.what(), "/textures/2/file", "cannot read image '" + dir.path() + "/empty.bmp' (the image has no pixels (3 x 0))",
+                 scene);
+  }
+}
+
 TEST(SceneParser, UnknownColorspaceIsRejected) {
   expect_error(image_texture_scene("x.png", "rec2020"), "/textures/2/colorspace",
                "unknown colorspace 'rec2020' (expected srgb, linear)");

@@ -42,8 +42,12 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
     t.a = colour(required(j, path, "high"), path / "high");
     t.b = colour(required(j, path, "low"), path / "low");
   } else {
-    check_keys(j, path, {"name", "type", "file", "colorspace", "uv_offset", "uv_scale", "uv_rotation", "wrap"},
+    check_keys(j, path,
+               {"name", "type", "file", "colorspace", "uv_offset", "uv_scale", "uv_rotation", "wrap", "filter"},
                "image");
+    if (j.contains("filter")) {
+      t.filter = static_cast<Filter>(choice(j["filter"], path / "filter", {"bilinear", "trilinear"}));
+    }
     t.kind = TextureKind::Image;
     if (j.contains("uv_offset")) t.uv_offset = pair(j["uv_offset"], path / "uv_offset");
     if (j.contains("uv_scale")) t.uv_scale = pair(j["uv_scale"], path / "uv_scale");
@@ -183,6 +187,12 @@ Texel* decode_with_stb(const std::string& path,
   if (file.overran && file.pad) {
     stbi_image_free(data);
     why = "the file is cut short: it ends before its pixels do";
+    return nullptr;
+  }
+  if (w < 1 || h < 1) {
+    // (A BMP's header may claim a height of 0, which stb decodes as no rows.)
+    stbi_image_free(data);
+    why = "the image has no pixels (" + std::to_string(w) + " x " + std::to_string(h) + ")";
     return nullptr;
   }
   return data;
