@@ -230,6 +230,16 @@ TEST(BsdfChiSquare, PlasticSamplesItsPdf) {
   }
 }
 
+// A metallic plastic: the mixture of the plastic and its metal, each picked by its
+// share, against the mixture's density.
+TEST(BsdfChiSquare, MetallicPlasticSamplesItsPdf) {
+  for (const std::string& r : {std::string("0"), std::string("0.05"), std::string("0.4"), std::string("1")}) {
+    const Case c = material(R"({"name": "m", "type": "plastic", "albedo": [0.9, 0.6, 0.2], "metallic": 0.5, "roughness": )" +
+                            r + "}");
+    for (double deg : kAngles) expect_fits(c, deg);
+  }
+}
+
 // (The fuzzy metal's density grows without bound at the rim of its cone, which
 // the midpoint rule here cannot integrate: metal_density_test.cpp tests fuzz below
 // 1 with a quadrature made for that rim.)
@@ -277,6 +287,13 @@ TEST(BsdfChiSquare, WrongDensitiesFail) {
     return 0.5f * li.z / kPi + 0.5f * g.visible_d(lo, h) / (4.0f * glm::dot(lo, h));
   };
   EXPECT_GT(z_of(c, wo, half, 0), kRejectZ) << "plastic with the coat's share 1/2";
+  // A metallic plastic whose density claims a metal share of 0.3 where it is 0.6.
+  const Case metallic = material(R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.5, 0.5], "metallic": 0.6, "roughness": 0.3})");
+  const BsdfAt mb = at(metallic, wo);
+  BsdfAt claimed = mb;
+  claimed.p.metallic = 0.3f;
+  EXPECT_LT(z_of(metallic, wo, pdf_of(mb, wo), 0), kRejectZ) << "metallic plastic: the right density";
+  EXPECT_GT(z_of(metallic, wo, pdf_of(claimed, wo), 0), kRejectZ) << "metallic plastic with the metal's share 0.3";
 }
 
 // Every non-specular sample's weight is eval / pdf and its pdf pdf(), to float rounding.
@@ -288,6 +305,8 @@ TEST(BsdfContract, SampleWeightIsEvalOverPdf) {
                            R"({"name": "m", "type": "conductor", "f0": [0.9, 0.6, 0.3], "roughness": 0.7, "anisotropy": 0.5})",
                            R"({"name": "m", "type": "glass", "roughness": 0.4, "tint": [0.9, 0.8, 0.7]})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.4})",
+                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.4, "metallic": 0.5})",
+                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "metallic": 0.5})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})"}) {
     const Case c = material(json);
     for (double deg : kAngles) {
@@ -321,6 +340,7 @@ TEST(BsdfContract, ReflectionIsReciprocal) {
                            R"({"name": "m", "type": "conductor", "metal": "copper", "roughness": 0.6, "masking": "separable"})",
                            R"({"name": "m", "type": "glass", "roughness": 0.5, "energy_compensation": false, "masking": "separable"})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5})",
+                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5, "metallic": 0.4})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})",
                            R"({"name": "m", "type": "glass", "roughness": 0.5, "energy_compensation": false})"}) {
     const Case c = material(json);
@@ -380,7 +400,8 @@ TEST(BsdfFurnace, NoBsdfReturnsMoreThanItReceives) {
                            R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": 1, "energy_compensation": false})",
                            R"({"name": "m", "type": "glass", "roughness": 0.6, "energy_compensation": false})",
                            R"({"name": "m", "type": "glass", "thin": true})",
-                           R"({"name": "m", "type": "plastic", "roughness": 0.6})"}) {
+                           R"({"name": "m", "type": "plastic", "roughness": 0.6})",
+                           R"({"name": "m", "type": "plastic", "roughness": 0.6, "metallic": 0.5})"}) {
     const Case c = material(json);
     for (double deg : kAngles) {
       for (bool outside : {true, false}) {
@@ -401,6 +422,14 @@ TEST(BsdfFurnace, AWhiteConductorOfAnyRoughnessReturnsEverything) {
       const Furnace f = furnace(c, incident(deg));
       EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";
       EXPECT_LT(4.0 * f.error, 0.005) << label(c, deg);
+    }
+  }
+  // A white fully metallic plastic is that conductor.
+  for (const std::string r : {"0.3", "1"}) {
+    const Case c = material(R"({"name": "m", "type": "plastic", "albedo": [1, 1, 1], "metallic": 1, "roughness": )" + r + "}");
+    for (double deg : {0.0, 60.0, 88.0}) {
+      const Furnace f = furnace(c, incident(deg));
+      EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";
     }
   }
   const Case single = material(R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": 1, "energy_compensation": false})");
@@ -457,6 +486,29 @@ TEST(BsdfTextures, ATexturedRoughnessIsTheRoughnessItScalesTo) {
       EXPECT_NEAR(f.mean, 1.0, 0.01) << "textured rough glass at " << deg << (outside ? "" : " inside");
     }
   }
+}
+
+// A metallic texture scales metallic by its blue channel: metallic 0.8 under a
+// constant 0.5 is metallic 0.4, to rounding.
+TEST(BsdfTextures, AMetallicTextureIsTheMetallicItScalesTo) {
+  const std::string half = R"({"name": "half", "type": "checker", "size": 1, "even": [0.1, 0.9, 0.5], "odd": [0.1, 0.9, 0.5]})";
+  const Case textured = material(
+      R"({"name": "m", "type": "plastic", "albedo": [0.8, 0.5, 0.2], "roughness": 0.4, "metallic": 0.8, "metallic_texture": "half"})",
+      half);
+  const Case plain = material(R"({"name": "m", "type": "plastic", "albedo": [0.8, 0.5, 0.2], "roughness": 0.4, "metallic": 0.4})");
+  int compared = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Rng rng = Rng::at(21, static_cast<uint32_t>(i), 0, 0);
+    const vec3 a = unit_sphere_point(rng.uniform(0), rng.uniform(1));
+    const vec3 d = unit_sphere_point(rng.uniform(2), rng.uniform(3));
+    if (a.z < 0.05f || d.z < 0.05f) continue;
+    float p_t, p_p;
+    const vec3 f_t = eval_bsdf(at(textured, a), a, d, p_t), f_p = eval_bsdf(at(plain, a), a, d, p_p);
+    ASSERT_NEAR(p_t, p_p, 1e-5f * p_p + 1e-6f) << "pair " << i;
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(f_t[k], f_p[k], 1e-5f * f_p[k] + 1e-6f) << "pair " << i;
+    ++compared;
+  }
+  EXPECT_GT(compared, 300);
 }
 
 }  // namespace

@@ -88,8 +88,9 @@ def in_view(center, radius):
 
 def build():
     rng = random.Random(SEED)
-    textures = [{"name": n, "type": "image", "file": "textures/%s.png" % n, "colorspace": "srgb"}
-                for n in IMAGES]
+    # Bilinear at full size, as the study's scenes have it (and the golden images).
+    textures = [{"name": n, "type": "image", "file": "textures/%s.png" % n, "colorspace": "srgb",
+                 "filter": "bilinear"} for n in IMAGES]
     textures.append({"name": "ground_checker", "type": "checker", "size": 2,
                      "even": [0.5, 0.5, 0.5], "odd": [0.15, 0.15, 0.15]})
     materials = [{"name": "ground", "type": "lambertian", "albedo": [1, 1, 1], "texture": "ground_checker"}]

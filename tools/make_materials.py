@@ -205,7 +205,8 @@ def build_table(single=False):
         "sky": {"type": "environment", "file": "textures/sky_sun.hdr", "mapping": "latlong", "rotation": 0,
                 "intensity": 1},
         "render": {"width": WIDTH, "height": HEIGHT, "spp": 64, "depth": 16, "roulette_depth": 5, "seed": 1},
-        "textures": [dict(t) for t in TEXTURES],
+        # Mitsuba's bitmap has no mip-maps: the -single twin filters as it does.
+        "textures": [dict(t, filter="bilinear") if single and t["type"] == "image" else dict(t) for t in TEXTURES],
         "materials": materials,
         "spheres": spheres,
         "meshes": [{"name": "plane", "file": PLANE_STEM + ".obj", "material": PLANE_MATERIAL["name"]}],

@@ -86,7 +86,9 @@ def check_counts(spheres):
 def build(spheres):
     check_counts(spheres)
     focus = math.sqrt(sum((a - b) ** 2 for a, b in zip(LOOK_FROM, LOOK_AT)))
-    textures = [{"name": name, "type": "image", "file": path, "colorspace": "linear"}
+    # The study sampled its images bilinearly at full size: its scenes say so, and
+    # keep its images (wavetrace's default is the trilinear, mip-mapped lookup).
+    textures = [{"name": name, "type": "image", "file": path, "colorspace": "linear", "filter": "bilinear"}
                 for name, path in IMAGES]
     textures.append({"name": CHECKER, "type": "checker", "size": 4,
                      "even": [0.95, 0.95, 0.95], "odd": [0.05, 0.05, 0.05]})

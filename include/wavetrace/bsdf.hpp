@@ -46,7 +46,7 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
   b.dpdu = sp.dpdu;
   b.front = sp.front;
   b.tables = in.tables;
-  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f};
+  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f, 0.0f, -1, -1};
   if constexpr (Microfacet) {
     if (m.params >= 0) {
       b.p = in.params[m.params];
@@ -59,6 +59,10 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
           b.p.internal = cosine_table(in.tables + b.p.table + b.p.table_rows * kEnergySize,
                                       table_roughness(Ggx{b.p.ax, b.p.ay}));
         }
+      }
+      if (b.p.metallic_texture >= 0) {
+        // Metallic scales by the texture's blue channel (glTF's metallicRoughnessTexture).
+        b.p.metallic *= fminf(fmaxf(eval_texture(in.textures[b.p.metallic_texture], in.images, sp).z, 0.0f), 1.0f);
       }
       if (b.p.normal_texture >= 0) {
         b.n = mapped_normal(sp.n, sp.dpdu, sp.tangent_sign,

@@ -24,6 +24,7 @@ struct Camera {
   vec3 vertical;    // focus-plane extent of the image, top to bottom
   vec3 u, v;        // lens basis
   float lens_radius;
+  float pixel_spread;  // the angle one pixel subtends at the centre of the view (radians)
 
   static Camera make(const CameraSpec& s, int width, int height) {
     vec3 w = glm::normalize(s.look_from - s.look_at);
@@ -40,10 +41,20 @@ struct Camera {
     c.u = u;
     c.v = v;
     c.lens_radius = 0.5f * s.aperture;
+    c.pixel_spread = 2.0f * half_h / static_cast<float>(height);
     return c;
   }
 
   // The primary ray through pixel (x, y), jittered inside the pixel and across the lens.
+  // The width of a pixel's footprint at p on a surface of unit normal ng reached
+  // along `dir` (unit): the pixel's spread at p's distance from the camera, stretched
+  // by the surface's slant (cos kept above 0.01). pbrt-v4 approximates every hit's
+  // footprint from the camera so, camera rays' and the bounces' alike.
+  WT_HD float footprint(const vec3& p, const vec3& ng, const vec3& dir) const {
+    const vec3 d = p - origin;
+    return pixel_spread * sqrtf(glm::dot(d, d)) / fmaxf(fabsf(glm::dot(ng, dir)), 0.01f);
+  }
+
   WT_HD Ray generate(int x, int y, int width, int height, const Rng& rng) const {
     float s = (static_cast<float>(x) + rng.uniform(kDimPixelX)) / static_cast<float>(width);
     float t = (static_cast<float>(y) + rng.uniform(kDimPixelY)) / static_cast<float>(height);

@@ -28,6 +28,7 @@ namespace wt {
 
 using glm::vec3;
 using glm::vec2;
+using glm::vec4;
 
 constexpr float kPi = 3.14159265358979323846f;
 

@@ -31,6 +31,7 @@ struct LightSample {
   vec3 dir;    // unit, from the shading point toward the light
   float dist;  // along dir to the light's surface
   float pdf;   // per solid angle; 0: no sample (the point is inside the light, or sees it edge-on)
+  float b1 = 0.0f, b2 = 0.0f;  // a triangle's point: the barycentric weights of corners 1 and 2
 };
 
 // Two unit vectors completing the unit vector n to a right-handed orthonormal basis
@@ -103,6 +104,8 @@ WT_HD WT_INLINE LightSample sample_triangle_light(const vec3& a, const vec3& b, 
   const float su = sqrtf(u1);
   const float b0 = 1.0f - su, b1 = u2 * su;
   const vec3 q = b0 * a + b1 * b + (1.0f - b0 - b1) * c;
+  s.b1 = b1;
+  s.b2 = 1.0f - b0 - b1;
   const vec3 v = q - p;
   const float dist = sqrtf(glm::dot(v, v));
   if (!(dist > 0.0f)) return s;

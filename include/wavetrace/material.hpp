@@ -42,6 +42,12 @@ struct MaterialParams {
   int32_t roughness_texture;  // -1, or the texture whose green channel scales the roughness
   int32_t normal_texture;     // -1, or a tangent-space normal map (linear colour)
   float normal_strength;      // scales the normal map's x and y (glTF's normalTexture.scale)
+  // Plastic: the share of a metal of f0 = albedo at the coat's roughness (glTF's
+  // metallic), scaled by metallic_texture's blue channel where it has one; and the
+  // metal's energy tables (the conductors', -1: uncompensated).
+  float metallic = 0.0f;
+  int32_t metallic_texture = -1;
+  int32_t metal_table = -1;
 };
 
 // Kept at 44 bytes: the constant-memory megakernel holds every material of a

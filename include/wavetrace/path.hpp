@@ -53,6 +53,17 @@ WT_HD WT_INLINE vec3 sky_seen(const Scene& scene, const RenderParams& rp, const 
   return sky * power_heuristic(pdf, sky_light_density(scene, dir));
 }
 
+// What emitter material m sends out at `hit`, reached along `ray`: its emission,
+// times its emission texture there where it has one. (Light sampling picks emitters
+// by the untextured emission, light_power_of's, for both of MIS's densities.)
+template <uint32_t Kinds, class Scene>
+WT_HD WT_INLINE vec3 emitted_radiance(const Scene& scene, const Material& m, const Ray& ray, const Hit& hit) {
+  if (m.texture < 0) return m.emission;
+  SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+  sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+  return m.emission * eval_texture(scene.texture_array()[m.texture], scene.image_array(), sp);
+}
+
 // A light sample's contribution, waiting for its shadow ray: added to the film
 // where nothing blocks `ray` before tmax.
 struct ShadowRay {
@@ -97,8 +108,9 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
     const EmitterShape shape = emitter_shape<Kinds>(scene, light.instance, light.prim);
     const LightSample s = shape.sample(sp.p, u1, u2);
     if (!(s.pdf > 0.0f) || (!either_side && glm::dot(s.dir, outward) <= 0.0f)) return out;
-    emitted = scene.material(material_index<Kinds>(scene, Hit{s.dist, light.instance, light.prim, 0.0f, 0.0f}))
-                  .emission;
+    const Hit at{s.dist, light.instance, light.prim, s.b1, s.b2};
+    const Material& lm = scene.material(material_index<Kinds>(scene, at));
+    emitted = emitted_radiance<Kinds>(scene, lm, Ray{sp.p, s.dir}, at);
     // The shadow ray leaves from the offset a ray leaving the surface starts at, and
     // is aimed at the sampled point itself, so that it ends on the light's surface
     // (shortened by kShadowShorten) however large the offset is.
@@ -111,7 +123,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
     // The density light_density gives when a path that leaves here in the same
     // direction hits the light, for the MIS weight.
     drawn_pdf = pick * s.pdf;
-    light_pdf = light_density(scene, emitted, shape, out.ray.origin, out.ray.dir, length);
+    light_pdf = light_density(scene, lm.emission, shape, out.ray.origin, out.ray.dir, length);
   }
   float bsdf_pdf;
   vec3 f_cos = eval_bsdf<(Kinds & kMicrofacet) != 0>(bsdf, wo, out.ray.dir, bsdf_pdf);
@@ -140,10 +152,12 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
       w = power_heuristic(pdf, light_density(scene, m.emission, emitter_shape<Kinds>(scene, hit.instance, hit.prim),
                                              ray.origin, ray.dir, hit.t));
     }
-    radiance += throughput * m.emission * w;
+    radiance += throughput * emitted_radiance<Kinds>(scene, m, ray, hit) * w;
     return false;
   }
-  const SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+  SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+  // The footprint that filters the material's image textures (texture_lod).
+  if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 wo = -ray.dir;
   constexpr bool kFacets = (Kinds & kMicrofacet) != 0;

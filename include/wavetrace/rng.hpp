@@ -33,6 +33,7 @@ enum RngDim : uint32_t {
   kDimLightPick = 10,
   kDimLightA = 11,
   kDimLightB = 12,
+  kDimLobe = 13,  // a mixture's choice of component (a metallic plastic's metal)
 };
 
 // Random numbers for one (seed, pixel, sample, bounce): `uniform(dim)` is in [0, 1).

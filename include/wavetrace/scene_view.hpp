@@ -40,7 +40,8 @@ struct RenderParams {
 //
 // The top-level nodes come first, then each tree's; the instances are in top-level
 // order; spheres and triangles are in BVH order, every mesh's triangles one range;
-// normals and uvs are per vertex, of the meshes that have them; material_params
+// normals and uvs are per vertex, of the meshes that have them, and tangents two per
+// such vertex (triangle.hpp), where the scene has a normal map; material_params
 // hold the microfacet kinds' parameters and bsdf_tables their energy tables
 // (bsdfs/energy.hpp); the lights are every
 // emitter, for next-event estimation, and light_cdf[i] the probability of picking
@@ -55,6 +56,7 @@ struct RenderParams {
   X(uint32_t, triangle_materials, triangle_material, uint32_t, int)               \
   X(vec3, normals, normal, vec3, uint32_t)                                        \
   X(vec2, uvs, uv, vec2, uint32_t)                                                \
+  X(vec3, tangents, tangent, vec3, uint32_t)                                      \
   X(Material, materials, material, const Material&, uint32_t)                     \
   X(MaterialParams, material_params, material_param, const MaterialParams&, int)  \
   X(float, bsdf_tables, bsdf_table, float, int)                                   \

@@ -1,6 +1,7 @@
 // Textures: procedural (checker, gradient noise) and images. An image is sampled
-// with the same bilinear arithmetic on every backend; on the GPU its texels come
-// through a CUDA texture object, on the CPU from host memory.
+// with the same bilinear (or trilinear, between mip levels) arithmetic on every
+// backend; on the GPU its texels come through CUDA texture objects, on the CPU from
+// host memory.
 #pragma once
 
 #include "wavetrace/geometry/surface.hpp"
@@ -13,6 +14,11 @@ enum class TextureKind : uint32_t { Checker = 0, Noise = 1, Image = 2 };
 
 // How an image texture's coordinates outside [0, 1] fall on it, per axis.
 enum class Wrap : uint32_t { Repeat = 0, Clamp = 1, Mirror = 2 };
+
+// How an image texture is filtered: bilinearly on the full image (the study's
+// lookup), or trilinearly between the two mip levels whose texels match the pixel's
+// footprint (minified textures do not alias).
+enum class Filter : uint32_t { Bilinear = 0, Trilinear = 1 };
 
 struct Texture {
   TextureKind kind;
@@ -27,9 +33,11 @@ struct Texture {
   vec2 uv_scale;
   float uv_cos, uv_sin;  // of the rotation
   Wrap wrap_u, wrap_v;
+  Filter filter;
 };
 
-// An image texture of image `image`, untransformed, wrapping u and v as given.
+// An image texture of image `image`, untransformed, wrapping u and v as given,
+// mip-mapped.
 inline Texture image_texture(int32_t image, Wrap wrap_u, Wrap wrap_v) {
   Texture t{};
   t.kind = TextureKind::Image;
@@ -38,6 +46,7 @@ inline Texture image_texture(int32_t image, Wrap wrap_u, Wrap wrap_v) {
   t.uv_cos = 1.0f;
   t.wrap_u = wrap_u;
   t.wrap_v = wrap_v;
+  t.filter = Filter::Trilinear;
   return t;
 }
 
@@ -89,11 +98,29 @@ WT_HD WT_INLINE float wrap_coordinate(float u, Wrap w) {
 
 // One image: a float RGBA texel array in linear colour. `object` is the CUDA texture
 // object (point sampling, unnormalised coordinates) on the GPU; `texels` the host copy.
+// Its mip levels 1, 2, ... (each half the one before, rounded down, at least 1 texel;
+// `levels` counts level 0 too, 1: none) lie in a second array, one below the other
+// from the top, level 1's width wide: `mip_object` and `mip_texels`.
 struct ImageView {
   unsigned long long object;
   const float* texels;  // RGBA, row-major, row 0 = top (v = 0)
   int32_t width, height;
+  unsigned long long mip_object = 0;
+  const float* mip_texels = nullptr;
+  int32_t levels = 1;
 };
+
+// Level `level`'s size, and where it starts in the mip array (level >= 1).
+WT_HD WT_INLINE void mip_level_shape(const ImageView& im, int level, int& w, int& h, int& row) {
+  w = im.width;
+  h = im.height;
+  row = 0;
+  for (int l = 1; l <= level; ++l) {
+    if (l > 1) row += h;
+    w = w > 1 ? w / 2 : 1;
+    h = h > 1 ? h / 2 : 1;
+  }
+}
 
 WT_HD WT_INLINE vec3 image_texel(const ImageView& im, int x, int y) {
 #if defined(__CUDA_ARCH__)
@@ -105,21 +132,66 @@ WT_HD WT_INLINE vec3 image_texel(const ImageView& im, int x, int y) {
 #endif
 }
 
-// Bilinear lookup (texel centres at half-integers), u and v wrapped by their modes
-// (by default u repeats and v clamps, the spheres' mapping).
-WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v, Wrap wrap_u = Wrap::Repeat,
-                                  Wrap wrap_v = Wrap::Clamp) {
-  float x = wrap_coordinate(u, wrap_u) * im.width - 0.5f;
-  float y = wrap_coordinate(v, wrap_v) * im.height - 0.5f;
+// Texel (x, y) of the mip array (`pitch`: its width, level 1's).
+WT_HD WT_INLINE vec3 mip_texel(const ImageView& im, int pitch, int x, int y) {
+#if defined(__CUDA_ARCH__)
+  (void)pitch;
+  float4 t = tex2D<float4>(static_cast<cudaTextureObject_t>(im.mip_object), x + 0.5f, y + 0.5f);
+  return vec3(t.x, t.y, t.z);
+#else
+  const float* p = im.mip_texels + 4 * (static_cast<size_t>(y) * pitch + x);
+  return vec3(p[0], p[1], p[2]);
+#endif
+}
+
+// Bilinear lookup (texel centres at half-integers) of an image of w x h texels, u
+// and v wrapped by their modes; `texel(x, y)` fetches.
+template <class Fetch>
+WT_HD WT_INLINE vec3 bilinear(int w, int h, float u, float v, Wrap wrap_u, Wrap wrap_v, const Fetch& texel) {
+  float x = wrap_coordinate(u, wrap_u) * w - 0.5f;
+  float y = wrap_coordinate(v, wrap_v) * h - 0.5f;
   float fx = floorf(x), fy = floorf(y);
   float ax = x - fx, ay = y - fy;
   int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
   int x1 = x0 + 1, y1 = y0 + 1;
-  wrap_taps(x0, x1, im.width, wrap_u);
-  wrap_taps(y0, y1, im.height, wrap_v);
-  vec3 top = (1.0f - ax) * image_texel(im, x0, y0) + ax * image_texel(im, x1, y0);
-  vec3 bottom = (1.0f - ax) * image_texel(im, x0, y1) + ax * image_texel(im, x1, y1);
+  wrap_taps(x0, x1, w, wrap_u);
+  wrap_taps(y0, y1, h, wrap_v);
+  vec3 top = (1.0f - ax) * texel(x0, y0) + ax * texel(x1, y0);
+  vec3 bottom = (1.0f - ax) * texel(x0, y1) + ax * texel(x1, y1);
   return (1.0f - ay) * top + ay * bottom;
+}
+
+// Bilinear lookup of the full image (by default u repeats and v clamps, the
+// spheres' mapping).
+WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v, Wrap wrap_u = Wrap::Repeat,
+                                  Wrap wrap_v = Wrap::Clamp) {
+  return bilinear(im.width, im.height, u, v, wrap_u, wrap_v,
+                  [&](int x, int y) { return image_texel(im, x, y); });
+}
+
+// Bilinear lookup of mip level `level` (0: the full image).
+WT_HD WT_INLINE vec3 sample_image_level(const ImageView& im, int level, float u, float v, Wrap wrap_u, Wrap wrap_v) {
+  if (level <= 0) return sample_image(im, u, v, wrap_u, wrap_v);
+  int w, h, row;
+  mip_level_shape(im, level, w, h, row);
+  int pitch = im.width > 1 ? im.width / 2 : 1;
+  return bilinear(w, h, u, v, wrap_u, wrap_v, [&](int x, int y) { return mip_texel(im, pitch, x, y + row); });
+}
+
+// Trilinear lookup at level of detail `lod` (log2 of the footprint in texels of
+// level 0): the two levels about it, blended linearly; the full image alone at
+// lod <= 0 (magnified), the coarsest level alone beyond it. Continuous in lod, so
+// that a level of detail off by rounding changes the result only by as much.
+WT_HD WT_INLINE vec3 sample_image_lod(const ImageView& im, float lod, float u, float v, Wrap wrap_u, Wrap wrap_v) {
+  if (!(lod > 0.0f) || im.levels <= 1) return sample_image(im, u, v, wrap_u, wrap_v);
+  const float top = static_cast<float>(im.levels - 1);
+  if (lod >= top) return sample_image_level(im, im.levels - 1, u, v, wrap_u, wrap_v);
+  const float fl = floorf(lod);
+  const int l = static_cast<int>(fl);
+  const float t = lod - fl;
+  const vec3 a = sample_image_level(im, l, u, v, wrap_u, wrap_v);
+  if (!(t > 0.0f)) return a;
+  return (1.0f - t) * a + t * sample_image_level(im, l + 1, u, v, wrap_u, wrap_v);
 }
 
 // The spherical mapping of the reference scene, from the unit normal at the hit.
@@ -127,6 +199,27 @@ WT_HD WT_INLINE vec2 sphere_uv(const vec3& n) {
   float u = 0.5f + atan2f(n.z, n.x) * (0.5f / kPi);
   float v = 0.5f - asinf(fminf(fmaxf(n.y, -1.0f), 1.0f)) / kPi;
   return vec2(u, v);
+}
+
+// The UV density (SurfacePoint::uv_density) of a sphere's mapping at its point:
+// u runs once around a circle of radius r sin(theta), v once from pole to pole, so
+// the square root of (du/dl)(dv/dl) is 1 / (pi r sqrt(2 sin theta)); sin theta is
+// kept above 1e-4 at the poles, where u's circles shrink to a point.
+WT_HD WT_INLINE float sphere_uv_density(const SurfacePoint& sp) {
+  const float r = sqrtf(glm::dot(sp.local, sp.local));
+  const float sin_theta = fmaxf(sqrtf(fmaxf(1.0f - sp.n.y * sp.n.y, 0.0f)), 1e-4f);
+  return r > 0.0f ? 1.0f / (kPi * r * sqrtf(2.0f * sin_theta)) : 0.0f;
+}
+
+// An image texture's level of detail at sp: log2 of the pixel's footprint there in
+// texels of the full image (the footprint's world width times the UV density, the
+// larger of the transform's scales, and the image's larger side), as ray cones give
+// it (Akenine-Moller et al. 2019) with pbrt-v4's footprint from the camera.
+WT_HD WT_INLINE float texture_lod(const Texture& t, const ImageView& im, const SurfacePoint& sp) {
+  const float density = sp.has_uv ? sp.uv_density : sphere_uv_density(sp);
+  const float scale = fmaxf(fabsf(t.uv_scale.x), fabsf(t.uv_scale.y));
+  const float texels = sp.footprint * density * scale * static_cast<float>(im.width > im.height ? im.width : im.height);
+  return texels > 0.0f ? log2f(texels) : 0.0f;
 }
 
 // Gradient noise on the integer lattice; gradients come from a hash of the lattice
@@ -187,7 +280,11 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
       if (WT_MUTANT(TextureVFlipped)) uv.y = 1.0f - uv.y;
       const vec2 s = uv * t.uv_scale;
       uv = t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
-      return sample_image(images[t.image], uv.x, uv.y, t.wrap_u, t.wrap_v);
+      const ImageView& im = images[t.image];
+      if (t.filter == Filter::Bilinear || !(sp.footprint > 0.0f) || im.levels <= 1) {
+        return sample_image(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
+      }
+      return sample_image_lod(im, texture_lod(t, im, sp), uv.x, uv.y, t.wrap_u, t.wrap_v);
     }
   }
   return vec3(0.0f);

@@ -1,9 +1,35 @@
 #include "cuda/device_scene.hpp"
 
+#include <algorithm>
+
 namespace wt::cuda {
 
 namespace {
 constexpr const char* kStage = "scene upload";
+}
+
+// An array of w x h RGBA float texels on the device, read through a texture object
+// by point sampling at unnormalised coordinates; kept until the scene goes.
+cudaTextureObject_t DeviceScene::texture_of(const float* texels, int w, int h) {
+  cudaChannelFormatDesc desc = cudaCreateChannelDesc<float4>();
+  cudaArray_t array = nullptr;
+  WT_CUDA(cudaMallocArray(&array, &desc, w, h), kStage);
+  arrays_.push_back(array);
+  const size_t row = static_cast<size_t>(w) * 4 * sizeof(float);
+  WT_CUDA(cudaMemcpy2DToArray(array, 0, 0, texels, row, row, h, cudaMemcpyHostToDevice), kStage);
+  cudaResourceDesc res{};
+  res.resType = cudaResourceTypeArray;
+  res.res.array.array = array;
+  cudaTextureDesc tex{};
+  tex.addressMode[0] = cudaAddressModeClamp;
+  tex.addressMode[1] = cudaAddressModeClamp;
+  tex.filterMode = cudaFilterModePoint;
+  tex.readMode = cudaReadModeElementType;
+  tex.normalizedCoords = 0;
+  cudaTextureObject_t object = 0;
+  WT_CUDA(cudaCreateTextureObject(&object, &res, &tex, nullptr), kStage);
+  objects_.push_back(object);
+  return object;
 }
 
 DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
@@ -16,28 +42,15 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   environment_conditional_.upload(scene.environment.conditional_cdf, kStage);
 
   // Texels are fetched one by one (point sampling) and filtered by the shared
-  // bilinear code, so the GPU computes exactly what the CPU computes.
+  // bilinear and trilinear code, so the GPU computes exactly what the CPU computes.
   for (const Image& im : scene.images) {
-    cudaChannelFormatDesc desc = cudaCreateChannelDesc<float4>();
-    cudaArray_t array = nullptr;
-    WT_CUDA(cudaMallocArray(&array, &desc, im.width, im.height), kStage);
-    arrays_.push_back(array);
-    const size_t row = static_cast<size_t>(im.width) * 4 * sizeof(float);
-    WT_CUDA(cudaMemcpy2DToArray(array, 0, 0, im.texels.data(), row, row, im.height, cudaMemcpyHostToDevice), kStage);
-
-    cudaResourceDesc res{};
-    res.resType = cudaResourceTypeArray;
-    res.res.array.array = array;
-    cudaTextureDesc tex{};
-    tex.addressMode[0] = cudaAddressModeClamp;
-    tex.addressMode[1] = cudaAddressModeClamp;
-    tex.filterMode = cudaFilterModePoint;
-    tex.readMode = cudaReadModeElementType;
-    tex.normalizedCoords = 0;
-    cudaTextureObject_t object = 0;
-    WT_CUDA(cudaCreateTextureObject(&object, &res, &tex, nullptr), kStage);
-    objects_.push_back(object);
-    image_views_.push_back(ImageView{object, nullptr, im.width, im.height});
+    const cudaTextureObject_t object = texture_of(im.texels.data(), im.width, im.height);
+    cudaTextureObject_t mips = 0;
+    if (im.levels > 1) {
+      const int pitch = std::max(im.width / 2, 1);
+      mips = texture_of(im.mip_texels.data(), pitch, static_cast<int>(im.mip_texels.size() / (4 * pitch)));
+    }
+    image_views_.push_back(ImageView{object, nullptr, im.width, im.height, mips, nullptr, im.levels});
   }
   images_.upload(image_views_, kStage);
 

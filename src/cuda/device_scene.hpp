@@ -21,6 +21,8 @@ class DeviceScene {
   const std::vector<ImageView>& image_views() const { return image_views_; }
 
  private:
+  cudaTextureObject_t texture_of(const float* texels, int w, int h);
+
 #define WT_DEVICE_BUFFER(T, array, at, Return, Index) DeviceBuffer<T> array##_;
   WT_SCENE_ARRAYS(WT_DEVICE_BUFFER)
 #undef WT_DEVICE_BUFFER

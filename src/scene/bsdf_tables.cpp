@@ -226,6 +226,13 @@ void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>
     case MaterialKind::Plastic:
       if (rough) p.table = append(plastic_table(m.ior, g, rows));
       p.internal = plastic_internal_reflectance(m.ior, g);
+      // A metallic plastic's metal uses the conductors' tables (its F_avg is formed
+      // at the hit, from the albedo there).
+      p.metal_table = -1;
+      if (compensated && p.metallic > 0.0f) {
+        if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
+        p.metal_table = conductor_offsets[separable];
+      }
       break;
     default:
       break;

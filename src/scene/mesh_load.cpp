@@ -53,7 +53,17 @@ class MeshBuilder {
  public:
   explicit MeshBuilder(TriangleMesh& mesh) : m_(mesh) {}
 
-  uint32_t add_vertex(const vec3& p, const vec3* n, const vec2* uv) {
+  uint32_t add_vertex(const vec3& p, const vec3* n, const vec2* uv, const vec4* tangent = nullptr) {
+    if (tangent) {
+      const vec3 t(*tangent);
+      if (!finite(t) || glm::length(t) == 0.0f || !(tangent->w == 1.0f || tangent->w == -1.0f)) {
+        fail(m_.source, "vertex " + std::to_string(m_.positions.size()) +
+                            " has a zero or non-finite TANGENT, or a handedness (w) other than 1 or -1");
+      }
+      m_.tangents.push_back(vec4(glm::normalize(t), tangent->w));
+    } else {
+      missing_tangent_ = true;
+    }
     if (m_.positions.size() >= std::numeric_limits<uint32_t>::max()) fail(m_.source, "more than 2^32 - 1 vertices");
     if (n) {
       if (!finite(*n) || glm::length(*n) == 0.0f) {
@@ -99,6 +109,7 @@ class MeshBuilder {
   void finish() {
     if (missing_normal_) m_.normals.clear();
     if (missing_uv_) m_.uvs.clear();
+    if (missing_tangent_ || missing_normal_ || missing_uv_) m_.tangents.clear();
     if (m_.triangles.empty()) {
       size_t dropped = m_.dropped_degenerate + m_.dropped_nan;
       fail(m_.source, dropped ? "no triangles left (" + std::to_string(m_.dropped_degenerate) + " degenerate and " +
@@ -111,6 +122,7 @@ class MeshBuilder {
   TriangleMesh& m_;
   bool missing_normal_ = false;
   bool missing_uv_ = false;
+  bool missing_tangent_ = false;
 };
 
 // The material appended for faces the file gives none, once.
@@ -663,6 +675,7 @@ class GltfReader {
     if (static_cast<size_t>(index) >= model_.meshes.size()) fail(path, "mesh index out of range");
     const tinygltf::Mesh& m = model_.meshes[index];
     const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+    const bool mirrors = glm::determinant(glm::dmat3(world)) < 0.0;
     for (size_t p = 0; p < m.primitives.size(); ++p) {
       const tinygltf::Primitive& prim = m.primitives[p];
       const std::string what = "mesh " + std::to_string(index) + " primitive " + std::to_string(p);
@@ -676,7 +689,11 @@ class GltfReader {
       const int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
       if (attribute("POSITION") < 0) fail(path, what + ": no POSITION attribute");
       Elements pos = elements(model_, attribute("POSITION"), what + " POSITION", TINYGLTF_TYPE_VEC3, {kFloat}, path);
-      Elements nrm, uv;
+      Elements nrm, uv, tan;
+      if (attribute("TANGENT") >= 0) {
+        tan = elements(model_, attribute("TANGENT"), what + " TANGENT", TINYGLTF_TYPE_VEC4, {kFloat}, path);
+        if (tan.count != pos.count) fail(path, what + ": TANGENT and POSITION counts differ");
+      }
       if (attribute("NORMAL") >= 0) {
         nrm = elements(model_, attribute("NORMAL"), what + " NORMAL", TINYGLTF_TYPE_VEC3, {kFloat}, path);
         if (nrm.count != pos.count) fail(path, what + ": NORMAL and POSITION counts differ");
@@ -712,7 +729,14 @@ class GltfReader {
         if (nrm.data) n = vec3(normal_matrix * glm::dvec3(component(nrm, i, 0), component(nrm, i, 1), component(nrm, i, 2)));
         // glTF puts v = 0 at the image's top row, as a mesh's UVs do.
         vec2 tc = uv.data ? vec2(component(uv, i, 0), component(uv, i, 1)) : vec2(0.0f);
-        builder_.add_vertex(world_pos[i], nrm.data ? &n : nullptr, uv.data ? &tc : nullptr);
+        // Tangents turn with the node as directions do; a mirroring node flips
+        // the handedness.
+        vec4 tg(0.0f);
+        if (tan.data) {
+          tg = vec4(vec3(glm::dmat3(world) * glm::dvec3(component(tan, i, 0), component(tan, i, 1), component(tan, i, 2))),
+                    component(tan, i, 3) * (mirrors ? -1.0f : 1.0f));
+        }
+        builder_.add_vertex(world_pos[i], nrm.data ? &n : nullptr, uv.data ? &tc : nullptr, tan.data ? &tg : nullptr);
       }
 
       Elements idx;

@@ -26,6 +26,9 @@ struct TriangleMesh {
   std::vector<vec3> positions;
   std::vector<vec3> normals;  // shading normals, one per vertex; empty where the file lacks any
   std::vector<vec2> uvs;      // one per vertex, v = 0 the image's top row; empty where the file lacks any
+  // One per vertex where the file gives them (glTF's TANGENT, with normals and UVs):
+  // xyz the unit tangent, w = +-1 the handedness (bitangent = w cross(normal, tangent)).
+  std::vector<vec4> tangents;
   std::vector<std::array<uint32_t, 3>> triangles;  // vertex indices
   std::vector<uint32_t> triangle_material;         // per triangle, an index into materials
   std::vector<MeshMaterial> materials;

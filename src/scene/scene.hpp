@@ -18,6 +18,11 @@ struct Image {
   int width = 0, height = 0;
   std::vector<float> texels;  // RGBA, linear, row 0 = top
   bool srgb_decoded = false;  // its 8-bit colours went through the sRGB decoding curve
+  // Mip levels 1, 2, ... (image_mips.hpp), one below the other, max(width / 2, 1)
+  // texels wide (texture.hpp's ImageView says how they are laid out); `levels`
+  // counts level 0 too (1: none built).
+  int levels = 1;
+  std::vector<float> mip_texels;
 };
 
 // The bounds of a scene's numbers, refused at load beyond them, so that no product the

@@ -290,7 +290,7 @@ size_t Scene::device_bytes() const {
   size_t total = 0 WT_SCENE_ARRAYS(WT_ARRAY_BYTES);
 #undef WT_ARRAY_BYTES
   total += bytes_of(environment.marginal_cdf) + bytes_of(environment.conditional_cdf);
-  for (const Image& im : images) total += bytes_of(im.texels);
+  for (const Image& im : images) total += bytes_of(im.texels) + bytes_of(im.mip_texels);
   return total;
 }
 

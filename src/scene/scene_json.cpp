@@ -7,6 +7,8 @@
 #include <utility>
 
 #include "errors/errors.hpp"
+#include "scene/image_mips.hpp"
+#include "scene/mesh_tangents.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace wt {
@@ -41,6 +43,16 @@ void SceneReader::read(const json& root) {
   }
   if (scene_.placements.empty()) {
     fail_at(top / "spheres", "the scene has nothing to render: it needs at least one sphere or one instance");
+  }
+  const auto start = Clock::now();
+  build_texture_mips(scene_);
+  texture_seconds_ += seconds_since(start);
+  // Tangents per vertex only where a normal map needs them.
+  for (const MaterialParams& p : scene_.material_params) {
+    if (p.normal_texture >= 0) {
+      build_tangents(scene_, file_tangents_);
+      break;
+    }
   }
 }
 
@@ -177,7 +189,9 @@ SceneScalars scene_scalars(const Scene& scene, int width, int height, const Piec
 
 SceneView host_view(const Scene& scene, int width, int height, std::vector<ImageView>& image_views) {
   image_views.clear();
-  for (const Image& im : scene.images) image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height});
+  for (const Image& im : scene.images) {
+    image_views.push_back(ImageView{0, im.texels.data(), im.width, im.height, 0, im.mip_texels.data(), im.levels});
+  }
   SceneView v{};
   static_cast<SceneScalars&>(v) = scene_scalars(scene, width, height, scene.environment.view());
 #define WT_HOST_POINTER(T, array, at, Return, Index) v.array = scene.array.data();

@@ -29,13 +29,13 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
       {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength"},
       {"name", "type", "ior", "albedo", "normal_texture", "normal_strength"},
       {"name", "type", "albedo", "ior", "texture", "normal_texture", "normal_strength"},
-      {"name", "type", "emission"},
+      {"name", "type", "emission", "emission_texture"},
       {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation", "masking",
        "roughness_texture", "normal_texture", "normal_strength"},
       {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation", "masking", "roughness_texture",
        "normal_texture", "normal_strength"},
       {"name", "type", "albedo", "texture", "ior", "roughness", "masking", "roughness_texture", "normal_texture",
-       "normal_strength"},
+       "normal_strength", "metallic", "metallic_texture", "energy_compensation"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -64,6 +64,8 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
     m.texture = texture_named(j["texture"], path / "texture");
     texture_kind = static_cast<int>(scene_.textures[m.texture].kind);
   }
+  // An emitter's texture slot is its emission's (it has no albedo).
+  if (j.contains("emission_texture")) m.texture = texture_named(j["emission_texture"], path / "emission_texture");
   if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic ||
       j.contains("normal_texture")) {
     read_params(j, path, m);
@@ -106,7 +108,15 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
   p.ay = g.ay;
   const bool compensate =
       j.contains("energy_compensation") ? boolean(j["energy_compensation"], path / "energy_compensation") : true;
-  if (compensate && m.kind != MaterialKind::Plastic) m.flags |= kMaterialCompensated;
+  // A plastic's coat is not compensated (Mitsuba's model); its metal is, where it has one.
+  if (m.kind == MaterialKind::Plastic) {
+    p.metallic = j.contains("metallic") ? unit_interval(j["metallic"], path / "metallic") : 0.0f;
+    if (j.contains("metallic_texture")) {
+      p.metallic_texture = texture_named(j["metallic_texture"], path / "metallic_texture");
+      if (!j.contains("metallic")) p.metallic = 1.0f;  // the texture's blue channel alone
+    }
+  }
+  if (compensate && (m.kind != MaterialKind::Plastic || p.metallic > 0.0f)) m.flags |= kMaterialCompensated;
   if (j.contains("masking") && choice(j["masking"], path / "masking", {"height-correlated", "separable"}) == 1) {
     m.flags |= kMaterialSeparable;
   }

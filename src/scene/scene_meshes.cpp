@@ -108,6 +108,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
     for (size_t v = 0; v < mesh.positions.size(); ++v) {
       scene_.normals.push_back(normals ? mesh.normals[v] : vec3(0.0f));
       scene_.uvs.push_back(uvs ? mesh.uvs[v] : vec2(0.0f));
+      file_tangents_.push_back(mesh.tangents.empty() ? vec4(0.0f) : mesh.tangents[v]);
     }
   }
   const uint32_t flags = (normals ? kTriangleHasNormals : 0u) | (uvs ? kTriangleHasUvs : 0u);

@@ -97,6 +97,9 @@ class SceneReader : JsonReader {
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;
   double mesh_seconds_ = 0;
+  // The mesh files' own tangents, per vertex of the scene's normal and UV arrays
+  // (w = 0 where a file gives none), for build_tangents.
+  std::vector<vec4> file_tangents_;
 };
 
 }  // namespace wt

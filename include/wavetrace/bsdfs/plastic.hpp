@@ -7,9 +7,15 @@
 // lost: a table per material) and R_int the coat's diffuse reflectance from inside,
 // summing the internal bounces as a geometric series. This is the model of Mitsuba
 // 3's plastic and roughplastic with `nonlinear` set. Two-sided.
+//
+// A metallic plastic (MaterialParams::metallic m > 0, glTF's metallic) mixes it
+// with a conductor of f0 = albedo (Schlick) at the coat's roughness, energy-
+// compensated as conductors are: f = (1 - m) f_plastic + m f_metal, sampled by
+// picking the metal with probability m, with the mixture's density.
 #pragma once
 
 #include "wavetrace/bsdfs/common.hpp"
+#include "wavetrace/bsdfs/conductor.hpp"
 #include "wavetrace/bsdfs/energy.hpp"
 #include "wavetrace/bsdfs/microfacet.hpp"
 
@@ -54,7 +60,7 @@ WT_HD WT_INLINE vec3 plastic_eval_local(const BsdfAt& b, const Ggx& g, const vec
   return f;
 }
 
-WT_HD WT_INLINE BsdfSample plastic_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
+WT_HD WT_INLINE BsdfSample plastic_base_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world);
   if (wo.z <= 0.0f) return no_sample();
@@ -81,9 +87,47 @@ WT_HD WT_INLINE BsdfSample plastic_sample(const BsdfAt& b, const vec3& wo_world,
   return BsdfSample{wi_world, f * (1.0f / pdf), pdf, (on_coat ? kLobeGlossy : kLobeDiffuse) | kLobeReflection};
 }
 
-WT_HD WT_INLINE vec3 plastic_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
+WT_HD WT_INLINE vec3 plastic_base_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   const Frame fr = b.facing_frame();
   return plastic_eval_local(b, plastic_ggx(b), fr.to_local(wo), fr.to_local(wi), pdf);
+}
+
+// A metallic plastic's metal: a Schlick conductor of f0 = albedo (F_avg = f0 +
+// (1 - f0) / 21, Schlick's cosine-weighted mean) on the coat's lobe.
+WT_HD WT_INLINE BsdfAt plastic_metal(const BsdfAt& b) {
+  BsdfAt m = b;
+  m.kind = MaterialKind::Conductor;
+  m.flags = (b.flags & kMaterialSeparable) | kMaterialSchlick | (b.p.metal_table >= 0 ? static_cast<uint32_t>(kMaterialCompensated) : 0u);
+  m.p.eta = b.albedo;
+  m.p.table = b.p.metal_table;
+  m.p.fresnel_average = b.albedo + (vec3(1.0f) - b.albedo) * (1.0f / 21.0f);
+  return m;
+}
+
+WT_HD WT_INLINE vec3 plastic_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
+  const float m = b.p.metallic;
+  vec3 f = plastic_base_eval(b, wo, wi, pdf);
+  if (!(m > 0.0f)) return f;
+  const BsdfAt metal = plastic_metal(b);
+  const float metal_pdf = conductor_pdf(metal, wo, wi);
+  pdf = (1.0f - m) * pdf + m * metal_pdf;
+  return (1.0f - m) * f + m * conductor_eval(metal, wo, wi);
+}
+
+WT_HD WT_INLINE BsdfSample plastic_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
+  const float m = b.p.metallic;
+  if (!(m > 0.0f)) return plastic_base_sample(b, wo_world, rng);
+  BsdfSample s = rng.uniform(kDimLobe) < m ? conductor_sample(plastic_metal(b), wo_world, rng)
+                                           : plastic_base_sample(b, wo_world, rng);
+  // A delta lobe's weight is its component's (the pick's probability cancels the
+  // mixture's factor); any other direction is weighed by the whole mixture.
+  if (s.lobe == 0u || (s.lobe & kLobeSpecular)) return s;
+  float pdf;
+  const vec3 f = plastic_eval(b, wo_world, s.wi, pdf);
+  if (!(pdf > 0.0f)) return no_sample();
+  s.weight = f * (1.0f / pdf);
+  s.pdf = pdf;
+  return s;
 }
 
 }  // namespace wt

@@ -240,10 +240,15 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
   if (sh.flags & kTriangleHasUvs) {
     const vec2 t0 = g.uv(sh.vertex[0]), t1 = g.uv(sh.vertex[1]), t2 = g.uv(sh.vertex[2]);
     sp.uv = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
+    const vec2 d1 = t1 - t0, d2 = t2 - t0;
+    const float det = d1.x * d2.y - d1.y * d2.x;  // twice the UV area, signed
+    // The UV density that picks a texture's mip level: sqrt(UV area / world area).
+    const vec3 area = in.identity ? ng
+                                  : glm::cross(in.world_from_object.vector(e1), in.world_from_object.vector(e2));
+    const float area2 = glm::dot(area, area);
+    sp.uv_density = area2 > 0.0f ? sqrtf(fabsf(det) / sqrtf(area2)) : 0.0f;
     // dp/du and dp/dv from p(u, v) over the triangle: solve the UV deltas of the two edges.
     if constexpr (Tangents) {
-      const vec2 d1 = t1 - t0, d2 = t2 - t0;
-      const float det = d1.x * d2.y - d1.y * d2.x;
       if (det != 0.0f) {
         const float inv = 1.0f / det;
         dpdu = (d2.y * e1 - d1.y * e2) * inv;
@@ -253,15 +258,29 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
   } else {
     sp.uv = vec2(hit.b1, hit.b2);
   }
-  sp.dpdu = dpdu;
   sp.tangent_sign = 1.0f;
   if constexpr (Tangents) {
+    // The mesh's per-vertex tangents where it has them (a file's, or built from
+    // the UVs as MikkTSpace builds them: build_tangents), interpolated; their
+    // handedness is the face's, mirrored again by a mirroring instance.
+    float vertex_sign = 0.0f;
+    if (sh.flags & kTriangleHasTangents) {
+      const uint32_t s = (sh.flags & kTriangleTangentFlipped) ? 1u : 0u;
+      const vec3 t = b0 * g.tangent(2u * sh.vertex[0] + s) + hit.b1 * g.tangent(2u * sh.vertex[1] + s) +
+                     hit.b2 * g.tangent(2u * sh.vertex[2] + s);
+      if (glm::dot(t, t) > 0.0f) {
+        dpdu = t;
+        vertex_sign = s ? -1.0f : 1.0f;
+        if (!in.identity && affine_determinant(in.world_from_object) < 0.0f) vertex_sign = -vertex_sign;
+      }
+    }
     if (!in.identity) {
-      sp.dpdu = in.world_from_object.vector(dpdu);
+      dpdu = in.world_from_object.vector(dpdu);
       dpdv = in.world_from_object.vector(dpdv);
     }
-    sp.tangent_sign = glm::dot(glm::cross(sp.n, sp.dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
+    sp.tangent_sign = vertex_sign != 0.0f ? vertex_sign : (glm::dot(glm::cross(sp.n, dpdu), dpdv) > 0.0f ? -1.0f : 1.0f);
   }
+  sp.dpdu = dpdu;
   sp.has_uv = true;
   sp.front = glm::dot(ray.dir, sp.ng) < 0.0f;
   // The point's error along the normal, and the rounding of adding the offset to it

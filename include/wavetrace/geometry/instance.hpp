@@ -33,6 +33,12 @@ struct Affine {
   WT_HD vec3 abs_translation() const { return vec3(fabsf(m[3]), fabsf(m[7]), fabsf(m[11])); }
 };
 
+// The determinant of a transform's linear part (< 0: it mirrors).
+WT_HD WT_INLINE float affine_determinant(const Affine& a) {
+  const float* m = a.m;
+  return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) + m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+
 constexpr Affine kIdentityTransform{{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}};
 
 enum class PrimitiveKind : uint32_t { Sphere = 0, Triangle = 1 };

@@ -16,6 +16,12 @@ struct SurfacePoint {
                 // sphere's azimuth, a triangle's from its UVs (its first edge without them)
   float tangent_sign;  // +-1: the bitangent cross(n, dpdu) times this points up the image
                        // (towards decreasing v), as a tangent-space normal map's +y
+  // Texture filtering (texture.hpp's mip-mapped lookups): UV units per unit length
+  // on the surface (isotropic: the square root of UV area over world area; triangles
+  // with UVs, 0 elsewhere: a sphere's follows from its normal), and the width of the
+  // pixel's footprint on the surface in world units (0: none, the finest level).
+  float uv_density = 0.0f;
+  float footprint = 0.0f;
   bool has_uv;  // false: spheres
   bool front;   // the ray arrived from the outward side
   float offset;  // how far a secondary ray starts from p along ng: covers p's rounding error

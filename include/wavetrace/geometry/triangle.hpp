@@ -34,6 +34,11 @@ struct TriangleShading {
 };
 constexpr uint32_t kTriangleHasNormals = 1u;
 constexpr uint32_t kTriangleHasUvs = 2u;
+// Per-vertex tangents (scene_view.hpp's `tangents`, where the scene has normal maps):
+// a vertex v has two, 2v for the faces of positive handedness and 2v + 1 for those
+// of negative (kTriangleTangentFlipped), so that a UV mirror seam keeps both.
+constexpr uint32_t kTriangleHasTangents = 4u;
+constexpr uint32_t kTriangleTangentFlipped = 8u;
 
 WT_HD WT_INLINE float component(const vec3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
