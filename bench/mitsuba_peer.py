@@ -899,6 +899,10 @@ class Converter:
                                                                     ("uv_rotation", 0))):
             self.notes.add("image texture '%s': its uv_scale, uv_offset and uv_rotation are not converted "
                            "(Mitsuba reads it at the surface's own UVs)" % t["name"])
+        if t is not None and t.get("filter", "trilinear") == "trilinear":
+            self.notes.add("image texture '%s': wavetrace filters it trilinearly between mip levels where it is "
+                           "minified, Mitsuba's bitmap bilinearly at full size (\"filter\": \"bilinear\" "
+                           "compares like with like)" % t["name"])
         if on_sphere:
             d["to_uv"] = transform(SPHERE_TO_UV)
         if not _is_white(albedo) and not self.allow_python:
@@ -1206,6 +1210,19 @@ class Converter:
             b.update({"type": "roughplastic", "distribution": "ggx", "sample_visible": True,
                       "alpha": self.textured(m, alpha, 2, on_sphere, to_object, takes_texture=False)})
             self._masking_note(m)
+        metallic = float(m.get("metallic", 1.0 if "metallic_texture" in m else 0.0))
+        if metallic > 0.0:
+            # The metal: a conductor reflecting the albedo at every angle, where
+            # wavetrace's is Schlick's from f0 = albedo (a brighter rim).
+            metal = {"type": "conductor", "material": "none",
+                     "specular_reflectance": self.reflectance(m, on_sphere, to_object)}
+            if alpha >= SMOOTH_ALPHA:
+                metal = dict(metal, type="roughconductor", distribution="ggx", sample_visible=True, alpha=alpha)
+            b = {"type": "blendbsdf", "weight": metallic, "bsdf_0": b, "bsdf_1": metal}
+            self.notes.add("plastic '%s', metallic %g: a blendbsdf of the plastic and a conductor of reflectance "
+                           "albedo (wavetrace's metal: Schlick's Fresnel from f0 = albedo, energy-compensated)%s" % (
+                               m["name"], metallic,
+                               "; its metallic_texture is not converted" if "metallic_texture" in m else ""))
         return b
 
     def bsdf_ref(self, m, on_sphere, to_object):
@@ -1228,6 +1245,9 @@ class Converter:
         if not any(e):
             return None
         d = {"type": "area", "radiance": _rgb(e)}
+        if "emission_texture" in m:
+            self.notes.add("emitter '%s': its emission_texture is not converted (Mitsuba's emits the untextured "
+                           "emission)" % m["name"])
         self.emitters.append((d, True, _mean3(e) * area))
         return d
 
