@@ -87,6 +87,39 @@ TEST(MaterialScene, TheMicrofacetKindsReadTheirFields) {
                kMicrofacet);
 }
 
+// The texture slots beyond the albedo: an emitter's emission texture, a plastic's
+// metallic (constant or textured) and the metal's tables.
+TEST(MaterialScene, EmissionAndMetallicSlotsReadTheirTextures) {
+  const Scene s = parse_scene(
+      R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]},
+          "textures": [{"name": "c", "type": "checker", "size": 1, "even": [1, 1, 1], "odd": [0, 0, 0]}],
+          "materials": [{"name": "lamp", "type": "emissive", "emission": [2, 2, 2], "emission_texture": "c"},
+                        {"name": "half", "type": "plastic", "roughness": 0.4, "metallic": 0.5},
+                        {"name": "mapped", "type": "plastic", "roughness": 0.4, "metallic_texture": "c"},
+                        {"name": "single", "type": "plastic", "roughness": 0.4, "metallic": 1, "energy_compensation": false},
+                        {"name": "none", "type": "plastic", "roughness": 0.4}],
+          "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "lamp"}]})",
+      kSource);
+  EXPECT_EQ(s.materials[0].texture, 0) << "the emission's texture";
+  const MaterialParams& half = s.material_params[s.materials[1].params];
+  EXPECT_FLOAT_EQ(half.metallic, 0.5f);
+  EXPECT_EQ(half.metallic_texture, -1);
+  EXPECT_GE(half.metal_table, 0) << "the metal is compensated by default";
+  const MaterialParams& mapped = s.material_params[s.materials[2].params];
+  EXPECT_FLOAT_EQ(mapped.metallic, 1.0f) << "the texture alone sets it";
+  EXPECT_EQ(mapped.metallic_texture, 0);
+  EXPECT_EQ(s.material_params[s.materials[3].params].metal_table, -1);
+  EXPECT_EQ(s.material_params[s.materials[4].params].metallic, 0.0f);
+  EXPECT_NE(error_of(one_sphere(R"({"name": "m", "type": "plastic", "metallic": 1.5})")).find("/materials/0/metallic"),
+            std::string::npos);
+  EXPECT_NE(error_of(one_sphere(R"({"name": "m", "type": "emissive", "emission": [1, 1, 1], "emission_texture": "x"})"))
+                .find("/materials/0/emission_texture: unknown texture 'x'"),
+            std::string::npos);
+  EXPECT_NE(error_of(one_sphere(R"({"name": "m", "type": "conductor", "metal": "gold", "metallic": 1})")).find("metallic"),
+            std::string::npos)
+      << "metallic belongs to plastic";
+}
+
 TEST(MaterialScene, BadFieldsNameTheFieldAndSayWhy) {
   struct Case {
     const char* material;
