@@ -92,9 +92,11 @@ constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene s
 // bounce's keys below it are gathered as the bits of one word.
 static_assert(kSortKeyMiss < 32, "the sort keys and the miss key must fit in 5 bits");
 
+// Filtered: with the mip-mapped lookups (texture.hpp's eval_texture).
+template <bool Filtered = true>
 WT_HD WT_INLINE vec3 material_albedo(const Material& m, const Texture* textures, const ImageView* images,
                                      const SurfacePoint& sp) {
-  return m.texture < 0 ? m.albedo : m.albedo * eval_texture(textures[m.texture], images, sp);
+  return m.texture < 0 ? m.albedo : m.albedo * eval_texture<Filtered>(textures[m.texture], images, sp);
 }
 
 }  // namespace wt

@@ -56,12 +56,17 @@ WT_HD WT_INLINE vec3 sky_seen(const Scene& scene, const RenderParams& rp, const 
 // What emitter material m sends out at `hit`, reached along `ray`: its emission,
 // times its emission texture there where it has one. (Light sampling picks emitters
 // by the untextured emission, light_power_of's, for both of MIS's densities.)
+// Kinds without kMicrofacet: compiled for scenes whose emitters are untextured.
 template <uint32_t Kinds, class Scene>
 WT_HD WT_INLINE vec3 emitted_radiance(const Scene& scene, const Material& m, const Ray& ray, const Hit& hit) {
-  if (m.texture < 0) return m.emission;
-  SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
-  sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
-  return m.emission * eval_texture(scene.texture_array()[m.texture], scene.image_array(), sp);
+  if constexpr ((Kinds & kMicrofacet) == 0) {
+    return m.emission;
+  } else {
+    if (m.texture < 0) return m.emission;
+    SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+    sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+    return m.emission * eval_texture(scene.texture_array()[m.texture], scene.image_array(), sp);
+  }
 }
 
 // A light sample's contribution, waiting for its shadow ray: added to the film
@@ -156,14 +161,16 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
     return false;
   }
   SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
   // The footprint that filters the material's image textures (texture_lod).
-  if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+  if constexpr (kFacets) {
+    if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+  }
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 wo = -ray.dir;
-  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
   const BsdfAt bsdf = bsdf_at<kFacets>(
       m, BsdfInputs{scene.material_param_array(), scene.bsdf_table_array(), scene.texture_array(), scene.image_array()},
-      sp, material_albedo(m, scene.texture_array(), scene.image_array(), sp), wo);
+      sp, material_albedo<kFacets>(m, scene.texture_array(), scene.image_array(), sp), wo);
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.

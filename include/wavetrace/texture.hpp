@@ -263,6 +263,9 @@ WT_HD WT_INLINE float turbulence(vec3 p, int octaves) {
 
 // Procedural textures are functions of the object-space point (a sphere's: relative
 // to its centre); images are looked up by the surface's UVs (a sphere's from its normal).
+// Filtered = false: compiled for kernels without the mip-mapped lookup (the study's
+// scenes: geometry.hpp's kMicrofacet), where every image is looked up bilinearly.
+template <bool Filtered = true>
 WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, const SurfacePoint& sp) {
   const vec3& local = sp.local;
   switch (t.kind) {
@@ -281,10 +284,12 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
       const vec2 s = uv * t.uv_scale;
       uv = t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
       const ImageView& im = images[t.image];
-      if (t.filter == Filter::Bilinear || !(sp.footprint > 0.0f) || im.levels <= 1) {
-        return sample_image(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
+      if constexpr (Filtered) {
+        if (t.filter == Filter::Trilinear && sp.footprint > 0.0f && im.levels > 1) {
+          return sample_image_lod(im, texture_lod(t, im, sp), uv.x, uv.y, t.wrap_u, t.wrap_v);
+        }
       }
-      return sample_image_lod(im, texture_lod(t, im, sp), uv.x, uv.y, t.wrap_u, t.wrap_v);
+      return sample_image(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
     }
   }
   return vec3(0.0f);

@@ -304,10 +304,17 @@ uint32_t Scene::primitive_kinds() const {
 
 uint32_t Scene::kernel_kinds() const {
   uint32_t kinds = primitive_kinds();
-  // The microfacet kinds, and any material with parameters beyond the study's (a
-  // normal map), need the kernels that read them.
+  // The microfacet kinds, any material with parameters beyond the study's (a
+  // normal map), a mip-mapped image texture and a textured emitter need the kernels
+  // that read them.
   for (const Material& m : materials) {
     if (m.params >= 0) kinds |= kMicrofacet;
+    if (m.texture >= 0 && static_cast<size_t>(m.texture) < textures.size()) {
+      const Texture& t = textures[static_cast<size_t>(m.texture)];
+      if (m.kind == MaterialKind::Emissive || (t.kind == TextureKind::Image && t.filter == Filter::Trilinear)) {
+        kinds |= kMicrofacet;
+      }
+    }
   }
   return kinds;
 }

@@ -34,9 +34,11 @@ constexpr uint32_t kAllKinds = kind_bit(PrimitiveKind::Sphere) | kind_bit(Primit
 constexpr uint32_t kLightSampling = 1u << 31;
 
 // Not a primitive kind either: a kernel compiled with the microfacet BSDFs
-// (conductor, glass, plastic: bsdf.hpp). Scenes of the study's materials alone run
-// kernels without their code, which costs the megakernel 5% on seed57 in registers
-// and instructions it never runs.
+// (conductor, glass, plastic: bsdf.hpp) and the texture features beyond the study's
+// (mip-mapped lookups, textured emission, normal maps). Scenes of the study's
+// materials and lookups alone run kernels without their code, which would cost the
+// megakernel 5% on seed57 for the BSDFs, and half its speed with the textures, in
+// registers and instructions it never runs.
 constexpr uint32_t kMicrofacet = 1u << 30;
 
 // Whether a kernel compiled for `kinds` serves spheres alone.
@@ -240,15 +242,16 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
   if (sh.flags & kTriangleHasUvs) {
     const vec2 t0 = g.uv(sh.vertex[0]), t1 = g.uv(sh.vertex[1]), t2 = g.uv(sh.vertex[2]);
     sp.uv = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
-    const vec2 d1 = t1 - t0, d2 = t2 - t0;
-    const float det = d1.x * d2.y - d1.y * d2.x;  // twice the UV area, signed
-    // The UV density that picks a texture's mip level: sqrt(UV area / world area).
-    const vec3 area = in.identity ? ng
-                                  : glm::cross(in.world_from_object.vector(e1), in.world_from_object.vector(e2));
-    const float area2 = glm::dot(area, area);
-    sp.uv_density = area2 > 0.0f ? sqrtf(fabsf(det) / sqrtf(area2)) : 0.0f;
-    // dp/du and dp/dv from p(u, v) over the triangle: solve the UV deltas of the two edges.
+    // dp/du and dp/dv from p(u, v) over the triangle: solve the UV deltas of the two
+    // edges; and the UV density that picks a texture's mip level, sqrt(UV area /
+    // world area). (Both only where kernels read them: Tangents.)
     if constexpr (Tangents) {
+      const vec2 d1 = t1 - t0, d2 = t2 - t0;
+      const float det = d1.x * d2.y - d1.y * d2.x;  // twice the UV area, signed
+      const vec3 area = in.identity ? ng
+                                    : glm::cross(in.world_from_object.vector(e1), in.world_from_object.vector(e2));
+      const float area2 = glm::dot(area, area);
+      sp.uv_density = area2 > 0.0f ? sqrtf(fabsf(det) / sqrtf(area2)) : 0.0f;
       if (det != 0.0f) {
         const float inv = 1.0f / det;
         dpdu = (d2.y * e1 - d1.y * e2) * inv;
