@@ -149,6 +149,10 @@ TEST(TextureMips, TheLevelOfDetailIsTheFootprintInTexels) {
               4.0f * 0.04f * std::sqrt(2.0f), 1e-5);
 }
 
+// The square [-1, 1]^2 in z = 0 facing +z, its UVs (0, 0) to (1, 1) over it.
+const char* kSquareObj = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                         "f 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+
 // A square of side 2 facing the camera at distance 3 and filling most of its view,
 // textured by a 256 x 256 checker of single black and white texels: a pixel of a
 // 16 x 16 render covers about 13 x 13 texels. Lambertian under a uniform sky of 1,
@@ -163,8 +167,7 @@ Scene checker_square(const test::TestFolder& folder, const char* filter) {
     }
   }
   EXPECT_NE(stbi_write_png((root + "/checker.png").c_str(), 256, 256, 4, px.data(), 256 * 4), 0);
-  std::ofstream(root + "/square.obj") << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
-                                         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  std::ofstream(root + "/square.obj") << kSquareObj;
   std::ofstream(root + "/scene.json") << R"({
     "camera": {"look_from": [0, 0, 3], "look_at": [0, 0, 0], "vfov": 30},
     "sky": {"type": "uniform", "radiance": [1, 1, 1]},
@@ -232,8 +235,7 @@ TEST(TextureMipRender, CudaLookupsAgreeWithTheCpuToRounding) {
     px.insert(px.end(), {c, static_cast<unsigned char>(255 - c), 128, 255});
   }
   ASSERT_NE(stbi_write_png((root + "/noise.png").c_str(), 512, 512, 4, px.data(), 512 * 4), 0);
-  std::ofstream(root + "/square.obj") << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\n"
-                                         "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+  std::ofstream(root + "/square.obj") << kSquareObj;
   std::ofstream(root + "/scene.json") << R"({
     "camera": {"look_from": [0, -2.2, 2], "look_at": [0, 0, 0], "vfov": 45},
     "sky": {"type": "uniform", "radiance": [1, 1, 1]},
