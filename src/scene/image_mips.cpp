@@ -17,20 +17,17 @@ void span(int i, int above, int below, int& first, int& last) {
 
 void build_mip_levels(Image& im) {
   if (im.levels > 1 || im.width < 1 || im.height < 1 || (im.width == 1 && im.height == 1)) return;
+  // The levels' sizes and rows are texture.hpp's layout (mip_level_shape), which the
+  // lookups read.
+  ImageView view{0, im.texels.data(), im.width, im.height, 0, nullptr, 1};
+  int w = im.width, h = im.height, row = 0;
+  while (w > 1 || h > 1) mip_level_shape(view, view.levels++, w, h, row);
   const int pitch = std::max(im.width / 2, 1);
-  // The levels' sizes, and the rows of the mip array they take.
-  std::vector<int> widths{im.width}, heights{im.height};
-  int rows = 0;
-  while (widths.back() > 1 || heights.back() > 1) {
-    widths.push_back(std::max(widths.back() / 2, 1));
-    heights.push_back(std::max(heights.back() / 2, 1));
-    rows += heights.back();
-  }
-  im.mip_texels.assign(static_cast<size_t>(pitch) * rows * 4, 0.0f);
+  im.mip_texels.assign(static_cast<size_t>(pitch) * (row + h) * 4, 0.0f);
   const float* above = im.texels.data();
-  int above_pitch = im.width, row = 0;
-  for (size_t l = 1; l < widths.size(); ++l) {
-    const int aw = widths[l - 1], ah = heights[l - 1], w = widths[l], h = heights[l];
+  int above_pitch = im.width, aw = im.width, ah = im.height;
+  for (int l = 1; l < view.levels; ++l) {
+    mip_level_shape(view, l, w, h, row);
     float* level = im.mip_texels.data() + static_cast<size_t>(row) * pitch * 4;
     for (int y = 0; y < h; ++y) {
       int y0, y1;
@@ -52,9 +49,10 @@ void build_mip_levels(Image& im) {
     }
     above = level;
     above_pitch = pitch;
-    row += h;
+    aw = w;
+    ah = h;
   }
-  im.levels = static_cast<int>(widths.size());
+  im.levels = view.levels;
 }
 
 void build_texture_mips(Scene& scene) {
