@@ -39,11 +39,10 @@ void build_tangents(Scene& scene, const std::vector<vec4>& file_tangents) {
     float sign;
     vec3 dpdu(0.0f);
     if (det != 0.0f) {
-      dpdu = (d2.y * e1 - d1.y * e2) / det;
-      const vec3 dpdv = (d1.x * e2 - d2.x * e1) / det;
-      const vec3 n = scene.normals[v[0]] + scene.normals[v[1]] + scene.normals[v[2]];
-      // The shading code's rule (SurfacePoint::tangent_sign): v grows down the image.
-      sign = glm::dot(glm::cross(n, dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
+      vec3 dpdv;
+      uv_derivatives(e1, e2, d1, d2, det, dpdu, dpdv);
+      // The shading code's rule, about the corners' mean normal.
+      sign = uv_handedness(scene.normals[v[0]] + scene.normals[v[1]] + scene.normals[v[2]], dpdu, dpdv);
     } else {
       sign = 1.0f;
     }

@@ -252,11 +252,7 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
                                     : glm::cross(in.world_from_object.vector(e1), in.world_from_object.vector(e2));
       const float area2 = glm::dot(area, area);
       sp.uv_density = area2 > 0.0f ? sqrtf(fabsf(det) / sqrtf(area2)) : 0.0f;
-      if (det != 0.0f) {
-        const float inv = 1.0f / det;
-        dpdu = (d2.y * e1 - d1.y * e2) * inv;
-        dpdv = (d1.x * e2 - d2.x * e1) * inv;
-      }
+      if (det != 0.0f) uv_derivatives(e1, e2, d1, d2, det, dpdu, dpdv);
     }
   } else {
     sp.uv = vec2(hit.b1, hit.b2);
@@ -281,7 +277,7 @@ WT_HD WT_INLINE SurfacePoint triangle_surface(const Geometry& g, const Instance&
       dpdu = in.world_from_object.vector(dpdu);
       dpdv = in.world_from_object.vector(dpdv);
     }
-    sp.tangent_sign = vertex_sign != 0.0f ? vertex_sign : (glm::dot(glm::cross(sp.n, dpdu), dpdv) > 0.0f ? -1.0f : 1.0f);
+    sp.tangent_sign = vertex_sign != 0.0f ? vertex_sign : uv_handedness(sp.n, dpdu, dpdv);
   }
   sp.dpdu = dpdu;
   sp.has_uv = true;

@@ -40,6 +40,21 @@ constexpr uint32_t kTriangleHasUvs = 2u;
 constexpr uint32_t kTriangleHasTangents = 4u;
 constexpr uint32_t kTriangleTangentFlipped = 8u;
 
+// dp/du and dp/dv over a triangle of edges e1, e2 whose UVs change by d1, d2 along
+// them (det = d1.x d2.y - d1.y d2.x, non-zero): p(u, v) solved for its derivatives.
+WT_HD WT_INLINE void uv_derivatives(const vec3& e1, const vec3& e2, const vec2& d1, const vec2& d2, float det,
+                                    vec3& dpdu, vec3& dpdv) {
+  const float inv = 1.0f / det;
+  dpdu = (d2.y * e1 - d1.y * e2) * inv;
+  dpdv = (d1.x * e2 - d2.x * e1) * inv;
+}
+
+// The UV map's handedness about normal n (SurfacePoint::tangent_sign): -1 where
+// cross(n, dp/du) points along dp/dv (v grows down the image), else +1.
+WT_HD WT_INLINE float uv_handedness(const vec3& n, const vec3& dpdu, const vec3& dpdv) {
+  return glm::dot(glm::cross(n, dpdu), dpdv) > 0.0f ? -1.0f : 1.0f;
+}
+
 WT_HD WT_INLINE float component(const vec3& v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
 // The per-ray part of the transformation: computed once per ray (per instance).
