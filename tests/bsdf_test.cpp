@@ -240,6 +240,18 @@ TEST(BsdfChiSquare, MetallicPlasticSamplesItsPdf) {
   }
 }
 
+// glTF's metallic-roughness (principled): the diffuse and the glossy lobe picked
+// by their shares, over roughness and metallic, against the mixture's density.
+TEST(BsdfChiSquare, PrincipledSamplesItsPdf) {
+  for (const std::string& rm : {std::string("0, \"metallic\": 0.3"), std::string("0.05, \"metallic\": 0.3"),
+                                std::string("0.4, \"metallic\": 0.3"), std::string("1, \"metallic\": 0.3"),
+                                std::string("0.5, \"metallic\": 0"), std::string("0.5, \"metallic\": 1"),
+                                std::string("0.5, \"anisotropy\": 0.7, \"ior\": 1.8")}) {
+    const Case c = material(R"({"name": "m", "type": "principled", "albedo": [0.9, 0.6, 0.2], "roughness": )" + rm + "}");
+    for (double deg : kAngles) expect_fits(c, deg);
+  }
+}
+
 // (The fuzzy metal's density grows without bound at the rim of its cone, which
 // the midpoint rule here cannot integrate: metal_density_test.cpp tests fuzz below
 // 1 with a quadrature made for that rim.)
@@ -262,7 +274,8 @@ TEST(BsdfChiSquare, WrongDensitiesFail) {
   const vec3 wo = incident(45.0);
   for (const char* json : {R"({"name": "m", "type": "conductor", "metal": "gold", "roughness": 0.3})",
                            R"({"name": "m", "type": "glass", "roughness": 0.3})",
-                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.5, 0.5], "roughness": 0.3})"}) {
+                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.5, 0.5], "roughness": 0.3})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.5, 0.5, 0.5], "roughness": 0.3, "metallic": 0.5})"}) {
     const Case c = material(json);
     const int side = c.m.kind == MaterialKind::Glass ? -1 : 0;  // glass: its transmission
     const BsdfAt b = at(c, wo);
@@ -294,6 +307,15 @@ TEST(BsdfChiSquare, WrongDensitiesFail) {
   claimed.p.metallic = 0.3f;
   EXPECT_LT(z_of(metallic, wo, pdf_of(mb, wo), 0), kRejectZ) << "metallic plastic: the right density";
   EXPECT_GT(z_of(metallic, wo, pdf_of(claimed, wo), 0), kRejectZ) << "metallic plastic with the metal's share 0.3";
+  // A principled material whose density claims metallic 0.2 (a smaller glossy
+  // share) where it is 0.7.
+  const Case principled =
+      material(R"({"name": "m", "type": "principled", "albedo": [0.5, 0.5, 0.5], "metallic": 0.7, "roughness": 0.3})");
+  const BsdfAt pb = at(principled, wo);
+  BsdfAt less_metal = pb;
+  less_metal.p.metallic = 0.2f;
+  EXPECT_LT(z_of(principled, wo, pdf_of(pb, wo), 0), kRejectZ) << "principled: the right density";
+  EXPECT_GT(z_of(principled, wo, pdf_of(less_metal, wo), 0), kRejectZ) << "principled claiming metallic 0.2";
 }
 
 // Every non-specular sample's weight is eval / pdf and its pdf pdf(), to float rounding.
@@ -307,7 +329,10 @@ TEST(BsdfContract, SampleWeightIsEvalOverPdf) {
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.4})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.4, "metallic": 0.5})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "metallic": 0.5})",
-                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})"}) {
+                           R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.5, 0.6, 0.7], "roughness": 0.4, "metallic": 0.5})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.5, 0.6, 0.7], "roughness": 0, "metallic": 0.2})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.5, 0.6, 0.7], "roughness": 1, "anisotropy": 0.5})"}) {
     const Case c = material(json);
     for (double deg : kAngles) {
       for (bool outside : {true, false}) {
@@ -331,6 +356,27 @@ TEST(BsdfContract, SampleWeightIsEvalOverPdf) {
   }
 }
 
+// glTF's doubleSided false: the back face reflects nothing, the front face as a
+// two-sided material does.
+TEST(BsdfContract, AOneSidedPrincipledBackFaceReflectsNothing) {
+  const Case one = material(R"({"name": "m", "type": "principled", "roughness": 0.5, "double_sided": false})");
+  const Case two = material(R"({"name": "m", "type": "principled", "roughness": 0.5})");
+  ASSERT_TRUE(one.m.flags & kMaterialOneSided);
+  ASSERT_FALSE(two.m.flags & kMaterialOneSided);
+  for (bool outside : {true, false}) {
+    const vec3 wo = incident(30.0, outside), wi = incident(50.0, outside);
+    const BsdfAt b1 = at(one, wo), b2 = at(two, wo);
+    EXPECT_EQ(bsdf_samples_lights(b1), outside);
+    EXPECT_TRUE(bsdf_samples_lights(b2));
+    const vec3 f1 = eval_bsdf(b1, wo, wi), f2 = eval_bsdf(b2, wo, wi);
+    EXPECT_GT(f2.x, 0.0f);
+    EXPECT_EQ(f1.x, outside ? f2.x : 0.0f) << (outside ? "front" : "back");
+    int scattered = 0;
+    for (int i = 0; i < 100; ++i) scattered += sample_bsdf(b1, wo, Rng::at(2, static_cast<uint32_t>(i), 0, 0)).lobe != 0u;
+    if (outside) EXPECT_GT(scattered, 90); else EXPECT_EQ(scattered, 0);
+  }
+}
+
 // Pairs of directions drawn uniformly over the sphere, both ways round.
 TEST(BsdfContract, ReflectionIsReciprocal) {
   for (const char* json : {R"({"name": "m", "type": "lambertian", "albedo": [0.5, 0.6, 0.7]})",
@@ -342,6 +388,8 @@ TEST(BsdfContract, ReflectionIsReciprocal) {
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5, "metallic": 0.4})",
                            R"({"name": "m", "type": "plastic", "albedo": [0.5, 0.6, 0.7]})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.5, 0.6, 0.7], "roughness": 0.5, "metallic": 0.4})",
+                           R"({"name": "m", "type": "principled", "albedo": [0.9, 0.6, 0.3], "roughness": 0.8, "anisotropy": 0.6, "metallic": 1})",
                            R"({"name": "m", "type": "glass", "roughness": 0.5, "energy_compensation": false})"}) {
     const Case c = material(json);
     int checked = 0;
@@ -401,7 +449,12 @@ TEST(BsdfFurnace, NoBsdfReturnsMoreThanItReceives) {
                            R"({"name": "m", "type": "glass", "roughness": 0.6, "energy_compensation": false})",
                            R"({"name": "m", "type": "glass", "thin": true})",
                            R"({"name": "m", "type": "plastic", "roughness": 0.6})",
-                           R"({"name": "m", "type": "plastic", "roughness": 0.6, "metallic": 0.5})"}) {
+                           R"({"name": "m", "type": "plastic", "roughness": 0.6, "metallic": 0.5})",
+                           R"({"name": "m", "type": "principled", "roughness": 0})",
+                           R"({"name": "m", "type": "principled", "roughness": 0.3})",
+                           R"({"name": "m", "type": "principled", "roughness": 1})",
+                           R"({"name": "m", "type": "principled", "roughness": 0.6, "metallic": 0.5})",
+                           R"({"name": "m", "type": "principled", "roughness": 0.6, "ior": 2.5})"}) {
     const Case c = material(json);
     for (double deg : kAngles) {
       for (bool outside : {true, false}) {
@@ -432,8 +485,31 @@ TEST(BsdfFurnace, AWhiteConductorOfAnyRoughnessReturnsEverything) {
       EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";
     }
   }
+  // And so is a white fully metallic principled material.
+  for (const std::string r : {"0.3", "1"}) {
+    const Case c = material(R"({"name": "m", "type": "principled", "metallic": 1, "roughness": )" + r + "}");
+    for (double deg : {0.0, 60.0, 88.0}) {
+      const Furnace f = furnace(c, incident(deg));
+      EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";
+    }
+  }
   const Case single = material(R"({"name": "m", "type": "conductor", "f0": [1, 1, 1], "roughness": 1, "energy_compensation": false})");
   EXPECT_LT(furnace(single, incident(80.0)).mean, 0.9) << "single scattering should lose energy at roughness 1";
+}
+
+// A white principled dielectric returns everything at any roughness: its base
+// takes what the specular layer does not reflect (albedo scaling, principled.hpp),
+// exactly when smooth, to the layer table's interpolation when rough; the glTF
+// specification's sketch, the base weighed by 1 - F at the pair's half vector,
+// returned 1.35 at 80 degrees when smooth.
+TEST(BsdfFurnace, AWhitePrincipledDielectricReturnsEverything) {
+  for (const std::string r : {"0", "0.3", "0.7", "1", R"(0.5, "ior": 2.2)"}) {
+    const Case c = material(R"({"name": "m", "type": "principled", "roughness": )" + r + "}");
+    for (double deg : {0.0, 45.0, 80.0}) {
+      const Furnace f = furnace(c, incident(deg));
+      EXPECT_NEAR(f.mean, 1.0, 0.01) << label(c, deg) << " (standard error " << f.error << ")";
+    }
+  }
 }
 
 // Compensated glass loses nothing on either side; a thin sheet and a white smooth

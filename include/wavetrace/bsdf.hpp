@@ -15,6 +15,7 @@
 #include "wavetrace/bsdfs/lambertian.hpp"
 #include "wavetrace/bsdfs/metal.hpp"
 #include "wavetrace/bsdfs/plastic.hpp"
+#include "wavetrace/bsdfs/principled.hpp"
 #include "wavetrace/mutant.hpp"
 
 namespace wt {
@@ -46,13 +47,16 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
   b.dpdu = sp.dpdu;
   b.front = sp.front;
   b.tables = in.tables;
-  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f, 0.0f, -1, -1};
+  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f, 0.0f, -1, -1, 1.0f};
   if constexpr (Microfacet) {
     if (m.params >= 0) {
       b.p = in.params[m.params];
+      // glTF's metallicRoughnessTexture is one texture for both: looked up once.
+      vec3 texel(1.0f);
       if (b.p.roughness_texture >= 0) {
         // Roughness scales by the texture's green channel, alpha by its square.
-        const float r = fminf(fmaxf(eval_texture(in.textures[b.p.roughness_texture], in.images, sp).y, 0.0f), 1.0f);
+        texel = eval_texture(in.textures[b.p.roughness_texture], in.images, sp);
+        const float r = fminf(fmaxf(texel.y, 0.0f), 1.0f);
         b.p.ax *= r * r;
         b.p.ay *= r * r;
         if (b.kind == MaterialKind::Plastic && b.p.table >= 0 && b.p.table_rows > 1) {
@@ -62,7 +66,10 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
       }
       if (b.p.metallic_texture >= 0) {
         // Metallic scales by the texture's blue channel (glTF's metallicRoughnessTexture).
-        b.p.metallic *= fminf(fmaxf(eval_texture(in.textures[b.p.metallic_texture], in.images, sp).z, 0.0f), 1.0f);
+        if (b.p.metallic_texture != b.p.roughness_texture) {
+          texel = eval_texture(in.textures[b.p.metallic_texture], in.images, sp);
+        }
+        b.p.metallic *= fminf(fmaxf(texel.z, 0.0f), 1.0f);
       }
       if (b.p.normal_texture >= 0) {
         b.n = mapped_normal(sp.n, sp.dpdu, sp.tangent_sign,
@@ -91,6 +98,12 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
       break;
     case MaterialKind::Plastic:
       if constexpr (Microfacet) return plastic_sample(b, wo, rng);
+      break;
+    case MaterialKind::Principled:
+      if constexpr (Microfacet) {
+        if ((b.flags & kMaterialOneSided) && !b.front) break;
+        return principled_sample(b, wo, rng);
+      }
       break;
     case MaterialKind::Emissive: break;
   }
@@ -127,6 +140,11 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
     case MaterialKind::Plastic:
       if constexpr (Microfacet) f = plastic_eval(b, wo, wi, pdf);
       break;
+    case MaterialKind::Principled:
+      if constexpr (Microfacet) {
+        if (!(b.flags & kMaterialOneSided) || b.front) f = principled_eval(b, wo, wi, pdf);
+      }
+      break;
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;
   }
@@ -152,6 +170,7 @@ WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
     case MaterialKind::Lambertian:
     case MaterialKind::Coated: return true;
     case MaterialKind::Plastic: return Microfacet;
+    case MaterialKind::Principled: return Microfacet && (!(b.flags & kMaterialOneSided) || b.front);
     case MaterialKind::Metal: return b.fuzz > 0.0f;
     case MaterialKind::Conductor: return Microfacet && !conductor_ggx(b).smooth();
     case MaterialKind::Glass: return Microfacet && !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();

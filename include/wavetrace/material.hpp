@@ -17,15 +17,17 @@ enum class MaterialKind : uint8_t {
   Conductor = 5,
   Glass = 6,
   Plastic = 7,
+  Principled = 8,
 };
-constexpr uint32_t kMaterialKindCount = 8;
+constexpr uint32_t kMaterialKindCount = 9;
 
 // Material::flags.
 enum MaterialFlag : uint16_t {
   kMaterialThin = 1,         // Glass: a thin sheet
   kMaterialSchlick = 2,      // Conductor: Fresnel from f0 (MaterialParams::eta) by Schlick's formula
   kMaterialCompensated = 4,  // Conductor, Glass: the energy lost to multiple scattering is put back
-  kMaterialSeparable = 8,    // Conductor, Glass, Plastic: separable Smith masking (Ggx::separable)
+  kMaterialSeparable = 8,    // Conductor, Glass, Plastic, Principled: separable Smith masking (Ggx::separable)
+  kMaterialOneSided = 16,    // Principled: a back face reflects nothing (glTF's doubleSided false)
 };
 
 // The parameters beyond the study's: the microfacet kinds' (conductor, glass,
@@ -48,6 +50,9 @@ struct MaterialParams {
   float metallic = 0.0f;
   int32_t metallic_texture = -1;
   int32_t metal_table = -1;
+  // Principled: the strength of the dielectric's specular layer (glTF's
+  // KHR_materials_specular specularFactor; 0: the base alone, a Lambertian).
+  float specular = 1.0f;
 };
 
 // Kept at 44 bytes: the constant-memory megakernel holds every material of a
@@ -60,33 +65,43 @@ struct Material {
   uint16_t flags;   // MaterialFlag
   int32_t texture;  // < 0: the constant albedo
   float fuzz;       // Metal
-  float ior;        // Dielectric, Coated (the coat), Glass, Plastic (the coat)
-  vec3 albedo;      // Lambertian, Metal, Coated, Plastic (the base); Dielectric, Glass: transmission tint
+  float ior;        // Dielectric, Coated (the coat), Glass, Plastic (the coat), Principled (the base)
+  vec3 albedo;      // Lambertian, Metal, Coated, Plastic (the base), Principled (the base colour);
+                    // Dielectric, Glass: transmission tint
   vec3 emission;    // Emissive
   int32_t params = -1;  // Conductor, Glass, Plastic: index into material_params (-1: none)
 };
 static_assert(sizeof(Material) == 44, "a material grows every constant-memory scene");
 
-// Sort keys: the non-emissive kinds in order, four keys each (the texture slot: 0
-// untextured, 1 + TextureKind), then one key for emitters, whose hits only add
-// their emission; the miss key follows.
-constexpr uint32_t kEmitterSortKey = (kMaterialKindCount - 1) * 4;
+// Sort keys. The kinds whose albedo a texture may set (lambertian, metal, coated,
+// plastic, principled) take four keys each (the texture slot: 0 untextured, 1 +
+// TextureKind), the others one (the dielectric keeps the study's four, of which it
+// uses the first, so that the study's kinds keep their keys), then one key for
+// emitters, whose hits only add their emission; the miss key follows.
+//   lambertian 0-3, metal 4-7, dielectric 8, coated 12-15, conductor 16, glass 17,
+//   plastic 18-21, principled 22-25, emitters 26, misses 27.
+constexpr uint8_t kKindFirstKey[kMaterialKindCount] = {0, 4, 8, 12, 26, 16, 17, 18, 22};
+constexpr uint32_t kEmitterSortKey = 26;
 WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /* -1: none */) {
-  const uint32_t k = static_cast<uint32_t>(kind);
-  if (kind == MaterialKind::Emissive) return kEmitterSortKey;
-  return (k < static_cast<uint32_t>(MaterialKind::Emissive) ? k : k - 1) * 4u + static_cast<uint32_t>(texture_kind + 1);
+  const bool textured = kind == MaterialKind::Lambertian || kind == MaterialKind::Metal ||
+                        kind == MaterialKind::Coated || kind == MaterialKind::Plastic ||
+                        kind == MaterialKind::Principled;
+  return kKindFirstKey[static_cast<uint32_t>(kind)] + (textured ? static_cast<uint32_t>(texture_kind + 1) : 0u);
 }
 constexpr uint32_t kSortKeyCount = kEmitterSortKey + 1;
 // The kind a sort key belongs to (material_sort_key's inverse in the kind).
 WT_HD WT_INLINE MaterialKind sort_key_kind(uint32_t key) {
   if (key >= kEmitterSortKey) return MaterialKind::Emissive;
-  const uint32_t slot = key / 4;
-  return static_cast<MaterialKind>(slot < static_cast<uint32_t>(MaterialKind::Emissive) ? slot : slot + 1);
+  if (key >= 22) return MaterialKind::Principled;
+  if (key >= 18) return MaterialKind::Plastic;
+  if (key == 17) return MaterialKind::Glass;
+  if (key == 16) return MaterialKind::Conductor;
+  return static_cast<MaterialKind>(key / 4 < 3 ? key / 4 : 3);
 }
 
-// The microfacet kinds' keys (conductor, glass, plastic: four each, after the
-// study's four kinds), whose shading costs several times a Lambertian's.
-constexpr uint32_t kMicrofacetKeyMask = ((1u << 12) - 1) << ((static_cast<uint32_t>(MaterialKind::Conductor) - 1) * 4);
+// The microfacet kinds' keys (conductor, glass, plastic, principled), whose shading
+// costs several times a Lambertian's.
+constexpr uint32_t kMicrofacetKeyMask = ((1u << 10) - 1) << 16;
 constexpr uint32_t kSortKeyMiss = kSortKeyCount;  // paths that left the scene sort last
 // The miss key must fit the bits above the slot (path_queue.hpp's 27 leave 5), and a
 // bounce's keys below it are gathered as the bits of one word.

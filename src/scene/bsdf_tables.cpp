@@ -197,11 +197,42 @@ float plastic_internal_reflectance(float ior, const Ggx& g) {
   return static_cast<float>(2.0 * sum / kCosines);
 }
 
-void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t* conductor_offsets) {
+std::vector<float> principled_table(float ior, bool separable, bool compensated) {
+  std::vector<float> t(kEnergySize * kEnergySize + kEnergySize);
+  const float* ct = conductor_energy_table(separable).data();
+  const float f0 = ((ior - 1.0f) / (ior + 1.0f)) * ((ior - 1.0f) / (ior + 1.0f));
+  const float f_avg = f0 + (1.0f - f0) / 21.0f;
+  for (int i = 0; i < kEnergySize; ++i) {
+    const float r = static_cast<float>(i) / (kEnergySize - 1);
+    const Ggx g{r * r, r * r, separable};
+    float* row = t.data() + i * kEnergySize;
+    const float e_avg = conductor_average_energy(ct, r);
+    for (int j = 0; j < kEnergySize; ++j) {
+      const float mu = grid_cosine(j);
+      if (g.smooth()) {
+        row[j] = schlick_f0(mu, vec3(f0)).x;
+        continue;
+      }
+      double e = mean_over_normals(g, view_at(mu), [&](const vec3& wo, const vec3& h) {
+        return schlick_f0(glm::dot(wo, h), vec3(f0)).x * reflected_weight(g, wo, h);
+      });
+      // The multiple-scattering lobe returns scale (1 - E(mu_o)) (1 - E_avg).
+      if (compensated) e += conductor_multiple_scale(vec3(f_avg), e_avg).x * (1.0f - conductor_energy(ct, r, mu)) * (1.0f - e_avg);
+      row[j] = static_cast<float>(e);
+    }
+    t[kEnergySize * kEnergySize + i] = cosine_average(row);
+  }
+  return t;
+}
+
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, SharedTables& shared) {
+  int32_t* conductor_offsets = shared.conductor;
   const bool separable = (m.flags & kMaterialSeparable) != 0;
   const Ggx g{p.ax, p.ay, separable};
   // A textured roughness can be any below the material's: its tables get a row per roughness.
-  const int rows = p.roughness_texture >= 0 && m.kind != MaterialKind::Conductor ? kEnergySize : 1;
+  const int rows = p.roughness_texture >= 0 && m.kind != MaterialKind::Conductor && m.kind != MaterialKind::Principled
+                       ? kEnergySize
+                       : 1;
   p.table_rows = rows;
   const bool rough = !g.smooth();
   const bool compensated = (m.flags & kMaterialCompensated) != 0 && rough;
@@ -223,6 +254,23 @@ void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>
     case MaterialKind::Glass:
       if (compensated && !(m.flags & kMaterialThin)) p.table = append(glass_energy_table(m.ior, g, rows));
       break;
+    case MaterialKind::Principled: {
+      // Its glossy lobes are Schlick conductors' (principled.hpp), compensated by
+      // the conductors' tables (metal_table); the base is weighed by the layer's.
+      p.metal_table = -1;
+      const bool compensate = (m.flags & kMaterialCompensated) != 0;
+      if (compensate) {
+        if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
+        p.metal_table = conductor_offsets[separable];
+      }
+      const auto key = std::make_tuple(m.ior, separable, compensate);
+      auto found = shared.principled.find(key);
+      if (found == shared.principled.end()) {
+        found = shared.principled.emplace(key, append(principled_table(m.ior, separable, compensate))).first;
+      }
+      p.table = found->second;
+      break;
+    }
     case MaterialKind::Plastic:
       if (rough) p.table = append(plastic_table(m.ior, g, rows));
       p.internal = plastic_internal_reflectance(m.ior, g);

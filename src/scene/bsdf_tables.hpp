@@ -3,6 +3,8 @@
 // that every backend reads the same numbers.
 #pragma once
 
+#include <map>
+#include <tuple>
 #include <vector>
 
 #include "wavetrace/bsdf.hpp"
@@ -26,10 +28,21 @@ std::vector<float> glass_energy_table(float ior, const Ggx& g, int rows);
 std::vector<float> plastic_table(float ior, const Ggx& g, int rows);
 float plastic_internal_reflectance(float ior, const Ggx& g);
 
+// The principled kind's layer table (principled.hpp): E_s(r, mu), the directional
+// albedo of its dielectric specular lobe (Schlick's Fresnel of f0 from `ior`, with
+// the multiple-scattering lobe where `compensated`), rows by roughness, then its
+// cosine-weighted average by row.
+std::vector<float> principled_table(float ior, bool separable, bool compensated);
+
+// Where tables shared between materials already are in the scene's bsdf_tables.
+struct SharedTables {
+  int32_t conductor[2] = {-1, -1};  // height-correlated, separable
+  std::map<std::tuple<float, bool, bool>, int32_t> principled;  // by (ior, separable, compensated)
+};
+
 // Fills the material's params for its kind (alphas already set, eta/k or f0 for
 // conductors): the compensation factors, the internal reflectance, and the tables,
-// appended to `tables` (the conductors' shared ones once: conductor_offsets[0]
-// and [1] hold where the height-correlated and the separable one are, -1 until then).
-void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, int32_t* conductor_offsets);
+// appended to `tables` (the shared ones once).
+void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, SharedTables& shared);
 
 }  // namespace wt

@@ -23,7 +23,7 @@ std::string preset_names() {
 void SceneReader::read_material(const json& j, const JsonPath& path) {
   // In MaterialKind's order.
   static const std::vector<std::string> kTypes = {"lambertian", "metal", "dielectric", "coated",
-                                                  "emissive",   "conductor", "glass", "plastic"};
+                                                  "emissive",   "conductor", "glass", "plastic", "principled"};
   static const std::vector<std::vector<std::string>> kKeys = {
       {"name", "type", "albedo", "texture", "normal_texture", "normal_strength"},
       {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength"},
@@ -36,6 +36,9 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
        "normal_texture", "normal_strength"},
       {"name", "type", "albedo", "texture", "ior", "roughness", "masking", "roughness_texture", "normal_texture",
        "normal_strength", "metallic", "metallic_texture", "energy_compensation"},
+      {"name", "type", "albedo", "texture", "ior", "roughness", "anisotropy", "metallic", "roughness_texture",
+       "metallic_texture", "normal_texture", "normal_strength", "energy_compensation", "masking", "double_sided",
+       "specular"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -52,7 +55,7 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   if (m.kind == MaterialKind::Dielectric || m.kind == MaterialKind::Coated) {
     m.ior = positive(required(j, path, "ior"), path / "ior");
   }
-  if (m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic) {
+  if (m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic || m.kind == MaterialKind::Principled) {
     m.ior = j.contains("ior") ? positive(j["ior"], path / "ior") : 1.5f;
   }
   if (m.kind == MaterialKind::Emissive) {
@@ -67,7 +70,7 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   // An emitter's texture slot is its emission's (it has no albedo).
   if (j.contains("emission_texture")) m.texture = texture_named(j["emission_texture"], path / "emission_texture");
   if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic ||
-      j.contains("normal_texture")) {
+      m.kind == MaterialKind::Principled || j.contains("normal_texture")) {
     read_params(j, path, m);
   }
   m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, texture_kind));
@@ -109,7 +112,7 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
   const bool compensate =
       j.contains("energy_compensation") ? boolean(j["energy_compensation"], path / "energy_compensation") : true;
   // A plastic's coat is not compensated (Mitsuba's model); its metal is, where it has one.
-  if (m.kind == MaterialKind::Plastic) {
+  if (m.kind == MaterialKind::Plastic || m.kind == MaterialKind::Principled) {
     p.metallic = j.contains("metallic") ? unit_interval(j["metallic"], path / "metallic") : 0.0f;
     if (j.contains("metallic_texture")) {
       p.metallic_texture = texture_named(j["metallic_texture"], path / "metallic_texture");
@@ -117,6 +120,11 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
     }
   }
   if (compensate && (m.kind != MaterialKind::Plastic || p.metallic > 0.0f)) m.flags |= kMaterialCompensated;
+  if (j.contains("specular")) p.specular = unit_interval(j["specular"], path / "specular");
+  if (m.kind == MaterialKind::Principled && j.contains("double_sided") &&
+      !boolean(j["double_sided"], path / "double_sided")) {
+    m.flags |= kMaterialOneSided;
+  }
   if (j.contains("masking") && choice(j["masking"], path / "masking", {"height-correlated", "separable"}) == 1) {
     m.flags |= kMaterialSeparable;
   }
@@ -154,7 +162,7 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
       m.flags |= kMaterialThin;
     }
   }
-  prepare_microfacet(m, p, scene_.bsdf_tables, conductor_tables_);
+  prepare_microfacet(m, p, scene_.bsdf_tables, shared_tables_);
   m.params = static_cast<int32_t>(scene_.material_params.size());
   scene_.material_params.push_back(p);
 }

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "scene/bsdf_tables.hpp"
 #include "scene/json_reader.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
@@ -90,9 +91,9 @@ class SceneReader : JsonReader {
   std::filesystem::path base_dir_;
   Names texture_names_;
   Names material_names_;
-  // Where the conductors' shared tables (height-correlated, separable) are in
-  // bsdf_tables (-1: not yet).
-  int32_t conductor_tables_[2] = {-1, -1};
+  // Where the tables that materials share (the conductors', the principled layers')
+  // are in bsdf_tables.
+  SharedTables shared_tables_;
   Names mesh_names_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;

@@ -50,7 +50,8 @@ constexpr std::array<Stage, 6> kAll = {kIntersect, kCompact, kReadback, kSort, k
 // Shade by material kind (RenderOptions::shade_by_kind), after the stages above.
 constexpr std::array<Stage, kMaterialKindCount> kShadeKinds = {
     Stage{6, "  lambertian"}, Stage{7, "  metal"},     Stage{8, "  dielectric"}, Stage{9, "  coated"},
-    Stage{10, "  emissive"},  Stage{11, "  conductor"}, Stage{12, "  glass"},     Stage{13, "  plastic"}};
+    Stage{10, "  emissive"},  Stage{11, "  conductor"}, Stage{12, "  glass"},     Stage{13, "  plastic"},
+    Stage{14, "  principled"}};
 }  // namespace stage
 
 // `wavefront` sorts a bounce's hits when they hold at least this many sort keys
