@@ -316,53 +316,93 @@ void expect_quad(const TriangleMesh& m) {
   EXPECT_EQ(m.triangle_material, (std::vector<uint32_t>{0, 0}));
   ASSERT_EQ(m.materials.size(), 1u);
   EXPECT_EQ(m.materials[0].name, "brass");
-  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Metal);
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Principled);
   expect_vec(m.materials[0].material.albedo, vec3(0.5f, 0.25f, 1.0f));
-  EXPECT_FLOAT_EQ(m.materials[0].material.fuzz, 0.25f);
+  EXPECT_FLOAT_EQ(m.materials[0].roughness, 0.25f);
 }
 
 TEST_F(MeshLoad, GltfWithAnEmbeddedBuffer) { expect_quad(load_mesh(write("quad.gltf", quad().embedded()))); }
 
 TEST_F(MeshLoad, Glb) { expect_quad(load_mesh(write("quad.glb", quad().binary()))); }
 
-TEST_F(MeshLoad, GltfMaterialsMapOntoTheNearestKind) {
+// Every non-emissive glTF material is `principled` with the file's factors; an
+// emissive one an emitter of emissiveFactor times KHR_materials_emissive_strength.
+TEST_F(MeshLoad, GltfMaterialsAreThePrincipledKindWithTheirFactors) {
   struct Case {
     std::string material;
     MaterialKind kind;
     vec3 albedo, emission;
-    float ior;
+    float ior, metallic, roughness;
+    bool one_sided;
   };
   const Case cases[] = {
       {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 0, "roughnessFactor": 0.9}})",
-       MaterialKind::Lambertian, vec3(0.5f), vec3(0.0f), 1.0f},
-      {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1], "metallicFactor": 0.2, "roughnessFactor": 0.1}})",
-       MaterialKind::Coated, vec3(0.1f, 0.2f, 0.3f), vec3(0.0f), 1.5f},
-      {R"({"emissiveFactor": [1, 0.5, 0]})", MaterialKind::Emissive, vec3(0.0f), vec3(1.0f, 0.5f, 0.0f), 1.0f},
-      // glTF's default: metallic 1, roughness 1.
-      {R"({})", MaterialKind::Metal, vec3(1.0f), vec3(0.0f), 1.0f},
+       MaterialKind::Principled, vec3(0.5f), vec3(0.0f), 1.5f, 0.0f, 0.9f, true},
+      {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1], "metallicFactor": 0.2, "roughnessFactor": 0.1},
+           "doubleSided": true, "extensions": {"KHR_materials_ior": {"ior": 1.7}}})",
+       MaterialKind::Principled, vec3(0.1f, 0.2f, 0.3f), vec3(0.0f), 1.7f, 0.2f, 0.1f, false},
+      {R"({"emissiveFactor": [1, 0.5, 0]})", MaterialKind::Emissive, vec3(0.0f), vec3(1.0f, 0.5f, 0.0f), 1.0f, 0.0f, 1.0f,
+       false},
+      {R"({"emissiveFactor": [1, 0.5, 0], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})",
+       MaterialKind::Emissive, vec3(0.0f), vec3(4.0f, 2.0f, 0.0f), 1.0f, 0.0f, 1.0f, false},
+      // glTF's default: metallic 1, roughness 1, single-sided.
+      {R"({})", MaterialKind::Principled, vec3(1.0f), vec3(0.0f), 1.5f, 1.0f, 1.0f, true},
   };
   for (const Case& c : cases) {
     TestGltf g = quad();
     g.material = c.material;
     TriangleMesh m = load_mesh(write("material.gltf", g.embedded()));
     ASSERT_EQ(m.materials.size(), 1u) << c.material;
-    const Material& got = m.materials[0].material;
-    EXPECT_EQ(m.materials[0].name, "material 0");
+    const MeshMaterial& mm = m.materials[0];
+    const Material& got = mm.material;
+    EXPECT_EQ(mm.name, "material 0");
     EXPECT_EQ(got.kind, c.kind) << c.material;
     expect_vec(got.albedo, c.albedo);
     expect_vec(got.emission, c.emission);
-    EXPECT_FLOAT_EQ(got.ior, c.ior);
+    EXPECT_FLOAT_EQ(got.ior, c.ior) << c.material;
+    if (c.kind != MaterialKind::Principled) continue;
+    EXPECT_FLOAT_EQ(mm.metallic, c.metallic) << c.material;
+    EXPECT_FLOAT_EQ(mm.roughness, c.roughness) << c.material;
+    EXPECT_EQ((got.flags & kMaterialOneSided) != 0, c.one_sided) << c.material;
+    EXPECT_TRUE(got.flags & kMaterialCompensated);
   }
 }
 
-TEST_F(MeshLoad, GltfBaseColourTextureIsAFileBesideTheMesh) {
+// The base colour, metallic-roughness and normal textures are files beside the
+// mesh (the normal map with its scale); the occlusion texture is read, not used.
+TEST_F(MeshLoad, GltfTexturesAreFilesBesideTheMesh) {
   TestGltf g = quad();
-  g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0}}}],
-    "textures": [{"source": 0}], "images": [{"uri": "maps/base.png"}], "samplers": [{})";
+  g.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0},
+      "metallicRoughnessTexture": {"index": 1}}, "normalTexture": {"index": 2, "scale": 0.8},
+      "occlusionTexture": {"index": 1}}],
+    "textures": [{"source": 0}, {"source": 1}, {"source": 2}],
+    "images": [{"uri": "maps/base.png"}, {"uri": "maps/mr.png"}, {"uri": "maps/normal.png"}], "samplers": [{})";
   TriangleMesh m = load_mesh(write("textured.gltf", g.embedded()));
   ASSERT_EQ(m.materials.size(), 1u);
-  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Lambertian);
-  EXPECT_EQ(m.materials[0].albedo_map, (folder_.root() / "maps/base.png").string());
+  const MeshMaterial& mm = m.materials[0];
+  EXPECT_EQ(mm.material.kind, MaterialKind::Principled);
+  EXPECT_EQ(mm.albedo_map, (folder_.root() / "maps/base.png").string());
+  EXPECT_EQ(mm.metallic_roughness_map, (folder_.root() / "maps/mr.png").string());
+  EXPECT_EQ(mm.normal_map, (folder_.root() / "maps/normal.png").string());
+  EXPECT_FLOAT_EQ(mm.normal_scale, 0.8f);
+}
+
+// What the materials' new fields refuse, each naming the material and the field.
+TEST_F(MeshLoad, GltfMaterialFieldsOutOfRangeAreRefused) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"extensions": {"KHR_materials_ior": {"ior": 0.5}}})", "KHR_materials_ior ior must be 0 or in [1, 10]"},
+      {R"({"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": -1}}})",
+       "KHR_materials_emissive_strength emissiveStrength must be a number in [0, 1e9]"},
+      {R"({"normalTexture": {"index": 0, "scale": -1}}], "textures": [{"source": 0}], "images": [{"uri": "n.png"}],
+          "samplers": [{})", "normalTexture scale must be in [0, 1000]"},
+      {R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}], "textures": [{"source": 0}],
+          "images": [{"uri": "b.png"}], "samplers": [{})", "base colour texture: texCoord 1 is not supported"},
+  };
+  for (const auto& [material, message] : cases) {
+    TestGltf g = quad();
+    g.material = material;
+    expect_error(write("bad.gltf", g.embedded()), std::string("material 'material 0': ") + message);
+  }
 }
 
 TEST_F(MeshLoad, GltfDropsAndCountsNanAndDegenerateTriangles) {
@@ -542,9 +582,10 @@ TEST_F(MeshLoad, GltfPrimitiveWithoutAMaterialGetsTheDefaultMaterial) {
   const TriangleMesh m = load_mesh(write("nomaterial.gltf", text));
   ASSERT_EQ(m.materials.size(), 1u);
   EXPECT_EQ(m.materials[0].name, "default");
-  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Metal);
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Principled);
   expect_vec(m.materials[0].material.albedo, vec3(1.0f));
-  EXPECT_FLOAT_EQ(m.materials[0].material.fuzz, 1.0f);
+  EXPECT_FLOAT_EQ(m.materials[0].metallic, 1.0f);
+  EXPECT_FLOAT_EQ(m.materials[0].roughness, 1.0f);
   expect_vec(m.materials[0].material.emission, vec3(0.0f));
   EXPECT_EQ(m.triangle_material, (std::vector<uint32_t>{0, 0}));
 }

@@ -150,9 +150,11 @@ def write_obj(path, positions, faces, uvs=None, groups=None, mtllib=None, header
 
 def write_gltf(path, positions, normals, uvs, indices, texture_uri, material_name):
     """A .gltf (JSON) with its buffer in a .bin beside it and one textured
-    Lambertian material (metallic 0, roughness 1) whose baseColorTexture is
-    the image texture_uri (relative to the file). uvs in glTF's convention:
-    v = 0 is the image's top row."""
+    Lambertian material whose baseColorTexture is the image texture_uri
+    (relative to the file): metallic 0, roughness 1 and KHR_materials_specular's
+    specularFactor 0, which leave glTF's BRDF its diffuse base alone, the model
+    Mitsuba's reference renders. uvs in glTF's convention: v = 0 is the image's
+    top row."""
     binname = os.path.splitext(os.path.basename(path))[0] + ".bin"
     blobs = [struct.pack("<%df" % (3 * len(positions)), *[c for p in positions for c in p]),
              struct.pack("<%df" % (3 * len(normals)), *[c for n in normals for c in n]),
@@ -169,9 +171,11 @@ def write_gltf(path, positions, normals, uvs, indices, texture_uri, material_nam
         "nodes": [{"mesh": 0, "name": "quad"}],
         "meshes": [{"name": "quad", "primitives": [{
             "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0, "mode": 4}]}],
+        "extensionsUsed": ["KHR_materials_specular"],
         "materials": [{"name": material_name, "pbrMetallicRoughness": {
             "baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0.0, "roughnessFactor": 1.0,
-            "baseColorTexture": {"index": 0}}}],
+            "baseColorTexture": {"index": 0}}, "doubleSided": True,
+            "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}}],
         "textures": [{"source": 0, "sampler": 0}],
         "samplers": [{"magFilter": 9729, "minFilter": 9729, "wrapS": 10497, "wrapT": 10497}],
         "images": [{"uri": texture_uri}],

@@ -515,42 +515,90 @@ uint32_t index_at(const Elements& e, size_t i) {
   }
 }
 
+// The file of a material's texture (textureInfo `index`, `texCoord`), resolved
+// against the mesh file's folder.
+std::string gltf_texture_file(const tinygltf::Model& model, int texture, int tex_coord, const std::string& where,
+                              const fs::path& dir, const std::string& path) {
+  if (static_cast<size_t>(texture) >= model.textures.size()) fail(path, where + " index out of range");
+  if (tex_coord != 0) {
+    fail(path, where + ": texCoord " + std::to_string(tex_coord) + " is not supported (only TEXCOORD_0)");
+  }
+  const int source = model.textures[texture].source;
+  if (source < 0 || static_cast<size_t>(source) >= model.images.size()) fail(path, where + ": image index out of range");
+  const tinygltf::Image& image = model.images[source];
+  if (image.uri.empty()) fail(path, where + " is embedded in the file (only image files are supported)");
+  return (dir / image.uri).lexically_normal().string();
+}
+
+// A number of a material extension's object, or `fallback` where it gives none.
+double extension_number(const tinygltf::Material& g, const char* extension, const char* field, double fallback) {
+  auto e = g.extensions.find(extension);
+  if (e == g.extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return fallback;
+  const tinygltf::Value& v = e->second.Get(field);
+  return v.IsNumber() ? v.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+}
+
 MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g, size_t index, const fs::path& dir,
                       const std::string& path) {
   MeshMaterial out;
   out.name = g.name.empty() ? "material " + std::to_string(index) : g.name;
+  const std::string what = "material '" + out.name + "'";
   const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
-  if (pbr.baseColorFactor.size() != 4) fail(path, "material '" + out.name + "': baseColorFactor must be 4 numbers");
-  if (g.emissiveFactor.size() != 3) fail(path, "material '" + out.name + "': emissiveFactor must be 3 numbers");
+  if (pbr.baseColorFactor.size() != 4) fail(path, what + ": baseColorFactor must be 4 numbers");
+  if (g.emissiveFactor.size() != 3) fail(path, what + ": emissiveFactor must be 3 numbers");
   vec3 base = checked_colour(path, out.name, "baseColorFactor", pbr.baseColorFactor.data(), false);
   vec3 emissive = checked_colour(path, out.name, "emissiveFactor", g.emissiveFactor.data(), true);
   auto unit = [&](double v, const char* field) {
-    if (!(v >= 0.0 && v <= 1.0)) fail(path, "material '" + out.name + "': " + field + " must be in [0, 1]");
+    if (!(v >= 0.0 && v <= 1.0)) fail(path, what + ": " + field + " must be in [0, 1]");
     return static_cast<float>(v);
   };
-  float metallic = unit(pbr.metallicFactor, "metallicFactor");
-  float roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  const double strength = extension_number(g, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
+  if (!(strength >= 0.0 && strength <= kMaxRadiance)) {
+    fail(path, what + ": KHR_materials_emissive_strength emissiveStrength must be a number in [0, 1e9]");
+  }
+  emissive *= static_cast<float>(strength);
+  if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > kMaxRadiance) {
+    fail(path, what + ": emissiveFactor times emissiveStrength exceeds 1e9 (the most radiance a scene may hold)");
+  }
+  const double ior = extension_number(g, "KHR_materials_ior", "ior", 1.5);
+  if (!(ior == 0.0 || (ior >= 1.0 && ior <= 10.0))) fail(path, what + ": KHR_materials_ior ior must be 0 or in [1, 10]");
   if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > 0.0f) {
     out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, emissive);
-  } else if (metallic >= 0.5f) {
-    out.material = make_material(MaterialKind::Metal, base, roughness, 1.0f, vec3(0.0f));
-  } else if (roughness < 0.5f) {
-    // glTF's dielectric reflectance (F0 = 0.04) is that of ior 1.5.
-    out.material = make_material(MaterialKind::Coated, base, 0.0f, 1.5f, vec3(0.0f));
-  } else {
-    out.material = make_material(MaterialKind::Lambertian, base, 0.0f, 1.0f, vec3(0.0f));
-  }
-  int texture = pbr.baseColorTexture.index;
-  if (texture >= 0 && textured(out.material.kind)) {
-    const std::string where = "material '" + out.name + "': base colour texture";
-    if (static_cast<size_t>(texture) >= model.textures.size()) fail(path, where + " index out of range");
-    int source = model.textures[texture].source;
-    if (source < 0 || static_cast<size_t>(source) >= model.images.size()) {
-      fail(path, where + ": image index out of range");
+    if (g.emissiveTexture.index >= 0) {
+      out.albedo_map = gltf_texture_file(model, g.emissiveTexture.index, g.emissiveTexture.texCoord,
+                                         what + ": emissive texture", dir, path);
     }
-    const tinygltf::Image& image = model.images[source];
-    if (image.uri.empty()) fail(path, where + " is embedded in the file (only image files are supported)");
-    out.albedo_map = (dir / image.uri).lexically_normal().string();
+    return out;
+  }
+  out.material = make_material(MaterialKind::Principled, base, 0.0f, 1.0f, vec3(0.0f));
+  // ior 0 is the extension's special case of f0 = 1; an index of 1e4 (f0 = 0.9996)
+  // stands in for it.
+  out.material.ior = ior == 0.0 ? 1e4f : static_cast<float>(ior);
+  out.material.flags = kMaterialCompensated | (g.doubleSided ? 0u : static_cast<uint32_t>(kMaterialOneSided));
+  out.metallic = unit(pbr.metallicFactor, "metallicFactor");
+  out.specular = unit(extension_number(g, "KHR_materials_specular", "specularFactor", 1.0),
+                      "KHR_materials_specular specularFactor");
+  out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  if (pbr.baseColorTexture.index >= 0) {
+    out.albedo_map = gltf_texture_file(model, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                       what + ": base colour texture", dir, path);
+  }
+  if (pbr.metallicRoughnessTexture.index >= 0) {
+    out.metallic_roughness_map =
+        gltf_texture_file(model, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                          what + ": metallic-roughness texture", dir, path);
+  }
+  if (g.normalTexture.index >= 0) {
+    out.normal_map = gltf_texture_file(model, g.normalTexture.index, g.normalTexture.texCoord,
+                                       what + ": normal texture", dir, path);
+    if (!(g.normalTexture.scale >= 0.0 && g.normalTexture.scale <= 1e3)) {
+      fail(path, what + ": normalTexture scale must be in [0, 1000]");
+    }
+    out.normal_scale = static_cast<float>(g.normalTexture.scale);
+  }
+  // Occlusion is read and checked, not applied: the paths find the occlusion.
+  if (g.occlusionTexture.index >= 0 && static_cast<size_t>(g.occlusionTexture.index) >= model.textures.size()) {
+    fail(path, what + ": occlusion texture index out of range");
   }
   return out;
 }

@@ -18,7 +18,16 @@ namespace wt {
 struct MeshMaterial {
   std::string name;        // as the file names it ("default" for faces without one)
   Material material{};     // texture < 0; sort_key set as for an untextured material
-  std::string albedo_map;  // the albedo texture's file, resolved against the mesh file's folder; "" for none
+  // The albedo texture's file (an emitter's: its emission's), resolved against the
+  // mesh file's folder; "" for none.
+  std::string albedo_map;
+  // `principled` (glTF's metallic-roughness): its factors, and the files of its
+  // metallic-roughness texture (G roughness, B metallic) and tangent-space normal
+  // map (both linear; "" for none), the normal map's x and y scaled by normal_scale.
+  float roughness = 1.0f, metallic = 0.0f;
+  float specular = 1.0f;  // KHR_materials_specular's specularFactor
+  std::string metallic_roughness_map, normal_map;
+  float normal_scale = 1.0f;
 };
 
 struct TriangleMesh {

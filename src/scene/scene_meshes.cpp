@@ -81,12 +81,32 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
     for (size_t i = 0; i < mesh.materials.size(); ++i) {
       const MeshMaterial& mm = mesh.materials[i];
       Material m = mm.material;
+      // Both axes repeat, as glTF's default sampler and OBJ's maps do.
+      auto texture_of = [&](const std::string& file, bool srgb) {
+        scene_.textures.push_back(image_texture(image_file(file, srgb, mesh.source), Wrap::Repeat, Wrap::Repeat));
+        return static_cast<int32_t>(scene_.textures.size() - 1);
+      };
       if (!mm.albedo_map.empty()) {
-        // Both axes repeat, as glTF's default sampler and OBJ's maps do.
-        const Texture t = image_texture(image_file(mm.albedo_map, true, mesh.source), Wrap::Repeat, Wrap::Repeat);
-        m.texture = static_cast<int32_t>(scene_.textures.size());
+        m.texture = texture_of(mm.albedo_map, true);
         m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, static_cast<int>(TextureKind::Image)));
-        scene_.textures.push_back(t);
+      }
+      if (m.kind == MaterialKind::Principled) {
+        MaterialParams p{};
+        p.table_rows = 1;
+        p.roughness_texture = p.normal_texture = -1;
+        p.normal_strength = mm.normal_scale;
+        const Ggx g = ggx_from_roughness(mm.roughness, 0.0f);
+        p.ax = g.ax;
+        p.ay = g.ay;
+        p.metallic = mm.metallic;
+        p.specular = mm.specular;
+        if (!mm.metallic_roughness_map.empty()) {
+          p.roughness_texture = p.metallic_texture = texture_of(mm.metallic_roughness_map, false);
+        }
+        if (!mm.normal_map.empty()) p.normal_texture = texture_of(mm.normal_map, false);
+        prepare_microfacet(m, p, scene_.bsdf_tables, shared_tables_);
+        m.params = static_cast<int32_t>(scene_.material_params.size());
+        scene_.material_params.push_back(p);
       }
       material_of[i] = static_cast<uint32_t>(scene_.materials.size());
       scene_.materials.push_back(m);
