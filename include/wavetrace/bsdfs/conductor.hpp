@@ -66,6 +66,20 @@ WT_HD WT_INLINE float conductor_pdf_local(const BsdfAt& b, const Ggx& g, const v
 
 WT_HD WT_INLINE Ggx conductor_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.flags & kMaterialSeparable) != 0}; }
 
+// A direction drawn from the rough lobe's density (conductor_pdf_local), local
+// frame, wo.z > 0: the multiple-scattering lobe by its share (its shape in mu_i,
+// energy.hpp, uniform in azimuth), else a visible normal's reflection.
+WT_HD WT_INLINE vec3 conductor_direction_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const Rng& rng) {
+  if (rng.uniform(kDimLayer) < conductor_multiple_share(b, g, wo.z)) {
+    float density;
+    const float mu = conductor_multiple_cosine(b.tables + b.p.table, table_roughness(g),
+                                               rng.uniform(kDimScatterA), density);
+    const float sin_t = sqrtf(fmaxf(0.0f, 1.0f - mu * mu)), phi = 2.0f * kPi * rng.uniform(kDimScatterB);
+    return vec3(sin_t * cosf(phi), sin_t * sinf(phi), mu);
+  }
+  return reflect_about(wo, g.sample_visible(wo, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB)));
+}
+
 WT_HD WT_INLINE BsdfSample conductor_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world);
@@ -76,17 +90,7 @@ WT_HD WT_INLINE BsdfSample conductor_sample(const BsdfAt& b, const vec3& wo_worl
     if (!b.same_side(wi)) return no_sample();
     return BsdfSample{wi, conductor_fresnel(b, wo.z), 0.0f, kLobeSpecular | kLobeReflection};
   }
-  vec3 wi;
-  if (rng.uniform(kDimLayer) < conductor_multiple_share(b, g, wo.z)) {
-    // The multiple-scattering lobe, by its shape in mu_i (energy.hpp) and uniform in azimuth.
-    float density;
-    const float mu = conductor_multiple_cosine(b.tables + b.p.table, table_roughness(g),
-                                               rng.uniform(kDimScatterA), density);
-    const float sin_t = sqrtf(fmaxf(0.0f, 1.0f - mu * mu)), phi = 2.0f * kPi * rng.uniform(kDimScatterB);
-    wi = vec3(sin_t * cosf(phi), sin_t * sinf(phi), mu);
-  } else {
-    wi = reflect_about(wo, g.sample_visible(wo, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB)));
-  }
+  const vec3 wi = conductor_direction_local(b, g, wo, rng);
   const float pdf = conductor_pdf_local(b, g, wo, wi);
   if (!(pdf > 0.0f)) return no_sample();
   const vec3 wi_world = fr.to_world(wi);

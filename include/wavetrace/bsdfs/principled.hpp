@@ -121,16 +121,7 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
     return BsdfSample{wi, mirror * (1.0f / q), 0.0f, kLobeSpecular | kLobeReflection};
   }
   if (glossy) {
-    const BsdfAt metal = principled_lobe(b, b.albedo);
-    if (rng.uniform(kDimLayer) < conductor_multiple_share(metal, g, wo.z)) {
-      float density;
-      const float mu = conductor_multiple_cosine(b.tables + metal.p.table, table_roughness(g),
-                                                 rng.uniform(kDimScatterA), density);
-      const float sin_t = sqrtf(fmaxf(0.0f, 1.0f - mu * mu)), phi = 2.0f * kPi * rng.uniform(kDimScatterB);
-      wi = vec3(sin_t * cosf(phi), sin_t * sinf(phi), mu);
-    } else {
-      wi = reflect_about(wo, g.sample_visible(wo, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB)));
-    }
+    wi = conductor_direction_local(principled_lobe(b, b.albedo), g, wo, rng);
   } else {
     wi = cosine_direction(vec3(0.0f, 0.0f, 1.0f), rng.uniform(kDimScatterA), rng.uniform(kDimScatterB));
   }
