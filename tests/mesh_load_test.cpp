@@ -144,7 +144,7 @@ TEST_F(MeshLoad, ObjGivesPositionsNormalsUvsTrianglesAndMaterials) {
   EXPECT_EQ(matte.name, "matte");
   EXPECT_EQ(matte.material.kind, MaterialKind::Lambertian);
   expect_vec(matte.material.albedo, vec3(0.5f, 0.25f, 0.125f));
-  EXPECT_EQ(matte.albedo_map, (folder_.root() / "tex/wood.png").string());
+  EXPECT_EQ(matte.albedo_map.image, (folder_.root() / "tex/wood.png").string());
   EXPECT_EQ(matte.material.texture, -1);
 
   const Material& steel = m.materials[1].material;
@@ -381,9 +381,9 @@ TEST_F(MeshLoad, GltfTexturesAreFilesBesideTheMesh) {
   ASSERT_EQ(m.materials.size(), 1u);
   const MeshMaterial& mm = m.materials[0];
   EXPECT_EQ(mm.material.kind, MaterialKind::Principled);
-  EXPECT_EQ(mm.albedo_map, (folder_.root() / "maps/base.png").string());
-  EXPECT_EQ(mm.metallic_roughness_map, (folder_.root() / "maps/mr.png").string());
-  EXPECT_EQ(mm.normal_map, (folder_.root() / "maps/normal.png").string());
+  EXPECT_EQ(mm.albedo_map.image, (folder_.root() / "maps/base.png").string());
+  EXPECT_EQ(mm.metallic_roughness_map.image, (folder_.root() / "maps/mr.png").string());
+  EXPECT_EQ(mm.normal_map.image, (folder_.root() / "maps/normal.png").string());
   EXPECT_FLOAT_EQ(mm.normal_scale, 0.8f);
 }
 
@@ -395,8 +395,8 @@ TEST_F(MeshLoad, GltfMaterialFieldsOutOfRangeAreRefused) {
        "KHR_materials_emissive_strength emissiveStrength must be a number in [0, 1e9]"},
       {R"({"normalTexture": {"index": 0, "scale": -1}}], "textures": [{"source": 0}], "images": [{"uri": "n.png"}],
           "samplers": [{})", "normalTexture scale must be in [0, 1000]"},
-      {R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1}}}], "textures": [{"source": 0}],
-          "images": [{"uri": "b.png"}], "samplers": [{})", "base colour texture: texCoord 1 is not supported"},
+      {R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 2}}}], "textures": [{"source": 0}],
+          "images": [{"uri": "b.png"}], "samplers": [{})", "base colour texture: texCoord 2 is not supported"},
   };
   for (const auto& [material, message] : cases) {
     TestGltf g = quad();
@@ -439,9 +439,9 @@ TEST_F(MeshLoad, GltfErrorsNameTheFileAndTheProblem) {
   expect_error(write("overrun.gltf", overrun), "POSITION (accessor 0): elements run past the end of the buffer view");
   TestGltf embedded_image = quad();
   embedded_image.material = R"({"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorTexture": {"index": 0}}}],
-    "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/png"}], "samplers": [{})";
+    "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/ktx2"}], "samplers": [{})";
   expect_error(write("image.gltf", embedded_image.embedded()),
-               "material 'material 0': base colour texture is embedded in the file (only image files are supported)");
+               "material 'material 0': base colour texture: image 0: KTX2 / Basis Universal textures are not supported");
 }
 
 // ---- OBJ numbers ----

@@ -16,9 +16,10 @@ enum class TextureKind : uint32_t { Checker = 0, Noise = 1, Image = 2 };
 enum class Wrap : uint32_t { Repeat = 0, Clamp = 1, Mirror = 2 };
 
 // How an image texture is filtered: bilinearly on the full image (the study's
-// lookup), or trilinearly between the two mip levels whose texels match the pixel's
-// footprint (minified textures do not alias).
-enum class Filter : uint32_t { Bilinear = 0, Trilinear = 1 };
+// lookup), trilinearly between the two mip levels whose texels match the pixel's
+// footprint (minified textures do not alias), or by the nearest texel of the full
+// image (glTF's NEAREST: pixel art stays sharp).
+enum class Filter : uint32_t { Bilinear = 0, Trilinear = 1, Nearest = 2 };
 
 struct Texture {
   TextureKind kind;
@@ -33,7 +34,11 @@ struct Texture {
   vec2 uv_scale;
   float uv_cos, uv_sin;  // of the rotation
   Wrap wrap_u, wrap_v;
+  // `filter` where the texture is minified (a texel smaller than the pixel's
+  // footprint), `magnify` (Bilinear or Nearest) where it is magnified or the kernel
+  // knows no footprint, as glTF's minFilter and magFilter.
   Filter filter;
+  Filter magnify;
 };
 
 // An image texture of image `image`, untransformed, wrapping u and v as given,
@@ -161,6 +166,13 @@ WT_HD WT_INLINE vec3 bilinear(int w, int h, float u, float v, Wrap wrap_u, Wrap 
   return (1.0f - ay) * top + ay * bottom;
 }
 
+// The nearest texel of the full image.
+WT_HD WT_INLINE vec3 sample_image_nearest(const ImageView& im, float u, float v, Wrap wrap_u, Wrap wrap_v) {
+  const int x = wrap_index(static_cast<int>(floorf(wrap_coordinate(u, wrap_u) * im.width)), im.width, wrap_u);
+  const int y = wrap_index(static_cast<int>(floorf(wrap_coordinate(v, wrap_v) * im.height)), im.height, wrap_v);
+  return image_texel(im, x, y);
+}
+
 // Bilinear lookup of the full image (by default u repeats and v clamps, the
 // spheres' mapping).
 WT_HD WT_INLINE vec3 sample_image(const ImageView& im, float u, float v, Wrap wrap_u = Wrap::Repeat,
@@ -285,10 +297,19 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
       uv = t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
       const ImageView& im = images[t.image];
       if constexpr (Filtered) {
-        if (t.filter == Filter::Trilinear && sp.footprint > 0.0f && im.levels > 1) {
-          return sample_image_lod(im, texture_lod(t, im, sp), uv.x, uv.y, t.wrap_u, t.wrap_v);
+        // The level of detail only where minifying and magnifying differ.
+        if (sp.footprint > 0.0f && (t.filter != t.magnify || (t.filter == Filter::Trilinear && im.levels > 1))) {
+          const float lod = texture_lod(t, im, sp);
+          if (lod > 0.0f) {
+            if (t.filter == Filter::Trilinear && im.levels > 1) {
+              return sample_image_lod(im, lod, uv.x, uv.y, t.wrap_u, t.wrap_v);
+            }
+            if (t.filter == Filter::Nearest) return sample_image_nearest(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
+            return sample_image(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
+          }
         }
       }
+      if (t.magnify == Filter::Nearest) return sample_image_nearest(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
       return sample_image(im, uv.x, uv.y, t.wrap_u, t.wrap_v);
     }
   }

@@ -254,6 +254,13 @@ void load_job(const Job& job, const Cluster& cluster, JobOutcome& out, std::opti
   scene.emplace(load_scene(job.scene));
   out.load_times = scene->load_times;
   out.geometry = scene->summary();
+  // What a mesh file holds that is not rendered, once (by the root rank), and in the
+  // stats file.
+  if (cluster.root()) {
+    for (const auto& m : out.geometry.meshes) {
+      for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: %s: %s\n", m.file.c_str(), w.c_str());
+    }
+  }
   options = resolve_options(job, *scene);
   out.params = options.params;
   out.backend = backend_name(options.backend);

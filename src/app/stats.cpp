@@ -37,15 +37,19 @@ nlohmann::json geometry_json(const Scene::Summary& g) {
                       {"top_level_bvh", bvh_json(g.top_level_bvh)}};
   if (g.spheres) j["sphere_bvh"] = bvh_json(g.sphere_bvh);
   nlohmann::json meshes = nlohmann::json::array();
+  size_t warnings = 0;  // over the meshes
   for (const auto& m : g.meshes) {
     meshes.push_back({{"name", m.name},
                       {"file", m.file},
                       {"triangles", m.triangle_count},
                       {"dropped_degenerate", m.dropped_degenerate},
                       {"dropped_nan", m.dropped_nan},
+                      {"warnings", m.warnings},
                       {"bvh", bvh_json(m.bvh)}});
+    warnings += m.warnings.size();
   }
   j["meshes"] = meshes;
+  j["warnings"] = warnings;
   return j;
 }
 

@@ -4,3 +4,7 @@
 #define TINYOBJLOADER_IMPLEMENTATION
 #define TINYGLTF_IMPLEMENTATION
 #include "scene/mesh_libraries.hpp"
+
+namespace wt {
+std::string gltf_uri_decode(const std::string& uri) { return tinygltf::dlib::urldecode(uri); }
+}  // namespace wt

@@ -10,3 +10,11 @@
 #define TINYGLTF_NO_EXTERNAL_IMAGE
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
+
+#include <string>
+
+namespace wt {
+// A glTF URI's percent-escapes decoded, by tinygltf's own decoder (as it decodes the
+// URIs of buffers): "my%20map.png" names "my map.png".
+std::string gltf_uri_decode(const std::string& uri);
+}  // namespace wt

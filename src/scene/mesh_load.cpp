@@ -198,7 +198,7 @@ MeshMaterial map_mtl(const tinyobj::material_t& t, const fs::path& dir, const st
     out.material = make_material(MaterialKind::Lambertian, kd, 0.0f, 1.0f, vec3(0.0f));
   }
   if (!t.diffuse_texname.empty() && textured(out.material.kind)) {
-    out.albedo_map = (dir / t.diffuse_texname).lexically_normal().string();
+    out.albedo_map.image = (dir / t.diffuse_texname).lexically_normal().string();
   }
   return out;
 }
@@ -432,7 +432,7 @@ void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) 
 
 // ---- glTF 2.0 ----
 
-// An accessor's elements, bounds-checked against its buffer view and buffer.
+// Elements in a buffer view, bounds-checked against the view and its buffer.
 struct Elements {
   const unsigned char* data = nullptr;
   size_t stride = 0, count = 0;
@@ -440,106 +440,310 @@ struct Elements {
   bool normalized = false;
 };
 
-Elements elements(const tinygltf::Model& model, int index, const std::string& what, int type,
-                  const std::vector<int>& components, const std::string& path) {
+// `count` elements of `elem` bytes from `offset` into buffer view `view` (`stride`
+// apart; 0: the view's own stride, or packed).
+Elements view_elements(const tinygltf::Model& model, int view_index, size_t offset, size_t count, size_t elem,
+                       const std::string& where, const std::string& path) {
+  if (view_index < 0 || static_cast<size_t>(view_index) >= model.bufferViews.size()) {
+    fail(path, where + ": buffer view index out of range");
+  }
+  const tinygltf::BufferView& view = model.bufferViews[view_index];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) {
+    fail(path, where + ": buffer index out of range");
+  }
+  const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
+  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset) {
+    fail(path, where + ": buffer view runs past the end of its buffer");
+  }
+  Elements e;
+  e.stride = view.byteStride ? view.byteStride : elem;
+  e.count = count;
+  if (e.stride < elem) fail(path, where + ": byte stride smaller than an element");
+  if (count > 0 && (offset > view.byteLength || elem > view.byteLength - offset ||
+                    (count - 1) > (view.byteLength - offset - elem) / e.stride)) {
+    fail(path, where + ": elements run past the end of the buffer view");
+  }
+  e.data = buffer.data() + view.byteOffset + offset;
+  return e;
+}
+
+// Component `c` of element `i`, as a number: normalized integers as the
+// specification maps them (unsigned to [0, 1], signed to [-1, 1]).
+double component(const Elements& e, size_t i, int c) {
+  const unsigned char* p = e.data + i * e.stride;
+  auto read = [&](auto v) {
+    std::memcpy(&v, p + sizeof(v) * c, sizeof(v));
+    return v;
+  };
+  switch (e.component) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const double v = read(int8_t{});
+      return e.normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      const double v = read(uint8_t{});
+      return e.normalized ? v / 255.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      const double v = read(int16_t{});
+      return e.normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      const double v = read(uint16_t{});
+      return e.normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      return read(uint32_t{});
+    default:
+      return read(float{});
+  }
+}
+
+// An accessor's elements, `n` components each, as type T: read from its buffer view
+// (or zeros, where it has none), then its sparse substitutions applied. Component
+// types: `components` (KHR_mesh_quantization's among them for attributes).
+template <class T>
+std::vector<T> read_accessor(const tinygltf::Model& model, int index, const std::string& what, int type,
+                             const std::vector<int>& components, const std::string& path) {
   if (index < 0 || static_cast<size_t>(index) >= model.accessors.size()) {
     fail(path, what + ": accessor index " + std::to_string(index) + " out of range");
   }
   const tinygltf::Accessor& a = model.accessors[index];
   const std::string where = what + " (accessor " + std::to_string(index) + ")";
-  if (a.sparse.isSparse) fail(path, where + ": sparse accessors are not supported");
   if (a.type != type) fail(path, where + ": wrong element type");
   if (std::find(components.begin(), components.end(), a.componentType) == components.end()) {
     fail(path, where + ": unsupported component type " + std::to_string(a.componentType));
   }
-  if (a.bufferView < 0 || static_cast<size_t>(a.bufferView) >= model.bufferViews.size()) {
-    fail(path, where + ": buffer view index out of range");
+  const int n = tinygltf::GetNumComponentsInType(a.type);
+  const size_t elem = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(a.componentType)) * n;
+  if (a.count > (size_t{1} << 32)) fail(path, where + ": more than 2^32 elements");
+  std::vector<T> out(a.count * n, T{});
+  auto copy = [&](const Elements& e, size_t from, size_t to) {
+    for (int c = 0; c < n; ++c) out[to * n + c] = static_cast<T>(component(e, from, c));
+  };
+  if (a.bufferView >= 0) {
+    Elements e = view_elements(model, a.bufferView, a.byteOffset, a.count, elem, where, path);
+    e.component = a.componentType;
+    e.normalized = a.normalized;
+    for (size_t i = 0; i < a.count; ++i) copy(e, i, i);
+  } else if (!a.sparse.isSparse) {
+    fail(path, where + ": no buffer view and no sparse values");
   }
-  const tinygltf::BufferView& view = model.bufferViews[a.bufferView];
-  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) {
-    fail(path, where + ": buffer index out of range");
-  }
-  const std::vector<unsigned char>& buffer = model.buffers[view.buffer].data;
-  const size_t elem = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(a.componentType)) *
-                      static_cast<size_t>(tinygltf::GetNumComponentsInType(a.type));
-  Elements e;
-  e.stride = view.byteStride ? view.byteStride : elem;
-  e.count = a.count;
-  e.component = a.componentType;
-  e.normalized = a.normalized;
-  if (view.byteOffset > buffer.size() || view.byteLength > buffer.size() - view.byteOffset) {
-    fail(path, where + ": buffer view runs past the end of its buffer");
-  }
-  if (e.stride < elem) fail(path, where + ": byte stride smaller than an element");
-  if (e.count > 0 && (a.byteOffset > view.byteLength || elem > view.byteLength - a.byteOffset ||
-                      (e.count - 1) > (view.byteLength - a.byteOffset - elem) / e.stride)) {
-    fail(path, where + ": elements run past the end of the buffer view");
-  }
-  e.data = buffer.data() + view.byteOffset + a.byteOffset;
-  return e;
-}
-
-float component(const Elements& e, size_t i, int c) {
-  const unsigned char* p = e.data + i * e.stride;
-  switch (e.component) {
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return e.normalized ? p[c] / 255.0f : p[c];
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v;
-      std::memcpy(&v, p + 2 * c, 2);
-      return e.normalized ? v / 65535.0f : v;
+  if (a.sparse.isSparse) {
+    const std::string sparse = where + " sparse";
+    if (a.sparse.count < 1 || static_cast<size_t>(a.sparse.count) > a.count) {
+      fail(path, sparse + ": count must be in [1, the accessor's count]");
     }
-    default: {
-      float v;
-      std::memcpy(&v, p + 4 * c, 4);
-      return v;
+    const size_t count = static_cast<size_t>(a.sparse.count);
+    const int ic = a.sparse.indices.componentType;
+    if (ic != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ic != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        ic != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+      fail(path, sparse + " indices: unsupported component type " + std::to_string(ic));
     }
-  }
-}
-
-uint32_t index_at(const Elements& e, size_t i) {
-  const unsigned char* p = e.data + i * e.stride;
-  switch (e.component) {
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return p[0];
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v;
-      std::memcpy(&v, p, 2);
-      return v;
-    }
-    default: {
-      uint32_t v;
-      std::memcpy(&v, p, 4);
-      return v;
+    if (a.sparse.indices.byteOffset < 0 || a.sparse.values.byteOffset < 0) fail(path, sparse + ": negative byteOffset");
+    Elements idx = view_elements(model, a.sparse.indices.bufferView, static_cast<size_t>(a.sparse.indices.byteOffset),
+                                 count, static_cast<size_t>(tinygltf::GetComponentSizeInBytes(ic)), sparse + " indices",
+                                 path);
+    idx.stride = static_cast<size_t>(tinygltf::GetComponentSizeInBytes(ic));  // sparse views are packed
+    idx.component = ic;
+    Elements values = view_elements(model, a.sparse.values.bufferView, static_cast<size_t>(a.sparse.values.byteOffset),
+                                    count, elem, sparse + " values", path);
+    values.stride = elem;
+    values.component = a.componentType;
+    values.normalized = a.normalized;
+    double previous = -1.0;
+    for (size_t i = 0; i < count; ++i) {
+      const double at = component(idx, i, 0);
+      if (at <= previous || at >= static_cast<double>(a.count)) {
+        fail(path, sparse + ": index " + std::to_string(static_cast<uint64_t>(at)) +
+                       (at >= static_cast<double>(a.count) ? " out of range" : " not increasing"));
+      }
+      previous = at;
+      copy(values, i, static_cast<size_t>(at));
     }
   }
+  return out;
 }
 
-// The file of a material's texture (textureInfo `index`, `texCoord`), resolved
-// against the mesh file's folder.
-std::string gltf_texture_file(const tinygltf::Model& model, int texture, int tex_coord, const std::string& where,
-                              const fs::path& dir, const std::string& path) {
-  if (static_cast<size_t>(texture) >= model.textures.size()) fail(path, where + " index out of range");
-  if (tex_coord != 0) {
-    fail(path, where + ": texCoord " + std::to_string(tex_coord) + " is not supported (only TEXCOORD_0)");
+// The extensions this reader reads; any other one a file requires is refused, and
+// any other it uses is a warning (what it adds is not rendered).
+const char* const kReadExtensions[] = {"KHR_materials_emissive_strength", "KHR_materials_ior",
+                                       "KHR_materials_specular", "KHR_texture_transform", "KHR_mesh_quantization"};
+
+bool read_extension(const std::string& name) {
+  return std::find(std::begin(kReadExtensions), std::end(kReadExtensions), name) != std::end(kReadExtensions);
+}
+
+void check_extensions(const tinygltf::Model& model, TriangleMesh& mesh) {
+  for (const std::string& e : model.extensionsRequired) {
+    if (read_extension(e)) continue;
+    const std::string what = e == "KHR_texture_basisu" ? " (KTX2 / Basis Universal textures)"
+                             : e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression"
+                                 ? " (compressed geometry)"
+                                 : "";
+    fail(mesh.source, "the file requires the extension " + e + what + ", which wavetrace does not read");
   }
-  const int source = model.textures[texture].source;
-  if (source < 0 || static_cast<size_t>(source) >= model.images.size()) fail(path, where + ": image index out of range");
-  const tinygltf::Image& image = model.images[source];
-  if (image.uri.empty()) fail(path, where + " is embedded in the file (only image files are supported)");
-  return (dir / image.uri).lexically_normal().string();
+  for (const std::string& e : model.extensionsUsed) {
+    if (!read_extension(e)) mesh.warnings.push_back("the extension " + e + " is used but not read; what it adds is not rendered");
+  }
 }
 
-// A number of a material extension's object, or `fallback` where it gives none.
-double extension_number(const tinygltf::Material& g, const char* extension, const char* field, double fallback) {
-  auto e = g.extensions.find(extension);
-  if (e == g.extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return fallback;
+// The number of an extension object's field, or `fallback` where it has none (NaN
+// where it is not a number).
+double extension_number(const tinygltf::ExtensionMap& extensions, const char* extension, const char* field,
+                        double fallback) {
+  auto e = extensions.find(extension);
+  if (e == extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return fallback;
   const tinygltf::Value& v = e->second.Get(field);
   return v.IsNumber() ? v.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
 }
 
-MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g, size_t index, const fs::path& dir,
-                      const std::string& path) {
+// The pair of an extension object's field, or `fallback`; false where it is not two
+// finite numbers.
+bool extension_pair(const tinygltf::ExtensionMap& extensions, const char* extension, const char* field, vec2& out) {
+  auto e = extensions.find(extension);
+  if (e == extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return true;
+  const tinygltf::Value& v = e->second.Get(field);
+  if (!v.IsArray() || v.ArrayLen() != 2) return false;
+  for (int i = 0; i < 2; ++i) {
+    if (!v.Get(i).IsNumber() || !std::isfinite(v.Get(i).GetNumberAsDouble())) return false;
+    out[i] = static_cast<float>(v.Get(i).GetNumberAsDouble());
+  }
+  return true;
+}
+
+bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+// KTX2's file identifier, the first 12 bytes of every KTX2 file.
+bool is_ktx2(const std::string& bytes) {
+  static const unsigned char kId[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
+  return bytes.size() >= 12 && std::memcmp(bytes.data(), kId, 12) == 0;
+}
+
+// What the glTF reader resolves textures against: the model, the mesh file's folder,
+// and the images already resolved (by image index: their MeshTexture::image).
+struct GltfImages {
+  const tinygltf::Model& model;
+  const fs::path& dir;
+  TriangleMesh& mesh;
+  std::map<int, std::string> keys;
+
+  // The image of texture `texture`: a file beside the mesh, or an embedded image
+  // (a buffer view, a data URI) kept in the mesh by its key.
+  std::string image_of(int texture, const std::string& where) {
+    const std::string& path = mesh.source;
+    const tinygltf::Texture& t = model.textures[texture];
+    int source = t.source;
+    if (source < 0) {
+      for (const char* e : {"KHR_texture_basisu", "EXT_texture_webp", "MSFT_texture_dds"}) {
+        if (t.extensions.count(e)) fail(path, where + ": its image is given only through " + e + ", which wavetrace does not read");
+      }
+      fail(path, where + ": the texture has no source image");
+    }
+    if (static_cast<size_t>(source) >= model.images.size()) fail(path, where + ": image index out of range");
+    auto known = keys.find(source);
+    if (known != keys.end()) return known->second;
+    const tinygltf::Image& image = model.images[source];
+    const std::string what = where + ": image " + std::to_string(source);
+    const char* const kKtx2 = ": KTX2 / Basis Universal textures are not supported (PNG, JPEG, BMP, TGA, HDR, EXR are)";
+    if (image.mimeType == "image/ktx2") fail(path, what + kKtx2);
+    std::string key;
+    if (image.bufferView >= 0 || !image.image.empty()) {
+      EmbeddedImage e;
+      e.key = path + "#images[" + std::to_string(source) + "]";
+      if (image.bufferView >= 0) {
+        const tinygltf::BufferView& view = model.bufferViews[image.bufferView];  // tinygltf checked the index
+        const Elements bytes = view_elements(model, image.bufferView, 0, 1, view.byteLength, what, path);
+        e.bytes.assign(reinterpret_cast<const char*>(bytes.data), view.byteLength);
+      } else {
+        e.bytes.assign(image.image.begin(), image.image.end());  // a data URI's, decoded from base64
+      }
+      if (e.bytes.empty()) fail(path, what + ": the embedded image is empty");
+      if (is_ktx2(e.bytes)) fail(path, what + kKtx2);
+      key = e.key;
+      mesh.embedded.push_back(std::move(e));
+    } else if (starts_with(image.uri, "data:")) {
+      // tinygltf decodes the data URIs of the image types it knows; this is another.
+      const std::string type = image.uri.substr(5, image.uri.find_first_of(";,") - 5);
+      if (type == "image/ktx2") fail(path, what + kKtx2);
+      fail(path, what + ": a data URI of type '" + type + "' is not an image wavetrace reads (PNG, JPEG, BMP, GIF are)");
+    } else if (image.uri.empty()) {
+      fail(path, what + " has neither a uri nor a buffer view");
+    } else {
+      key = (dir / gltf_uri_decode(image.uri)).lexically_normal().string();
+      std::string ext = fs::path(key).extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      if (ext == ".ktx2" || ext == ".basis") fail(path, what + kKtx2);
+    }
+    keys.emplace(source, key);
+    return key;
+  }
+
+  // A material's texture (a textureInfo: `index`, `texCoord`, and
+  // KHR_texture_transform), with its sampler's wrap and filters; `uv_set` is the
+  // TEXCOORD set it reads.
+  template <class Info>
+  MeshTexture texture(const Info& info, const std::string& where, int& uv_set) {
+    const std::string& path = mesh.source;
+    if (info.index < 0 || static_cast<size_t>(info.index) >= model.textures.size()) fail(path, where + " index out of range");
+    MeshTexture out;
+    out.image = image_of(info.index, where);
+    const int sampler = model.textures[info.index].sampler;
+    if (sampler >= 0) {
+      if (static_cast<size_t>(sampler) >= model.samplers.size()) fail(path, where + ": sampler index out of range");
+      const tinygltf::Sampler& s = model.samplers[sampler];
+      auto wrap = [&](int mode, const char* field) {
+        switch (mode) {
+          case TINYGLTF_TEXTURE_WRAP_REPEAT: return Wrap::Repeat;
+          case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return Wrap::Clamp;
+          case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return Wrap::Mirror;
+        }
+        fail(path, where + ": sampler " + std::to_string(sampler) + " " + field + " " + std::to_string(mode) +
+                       " is not a wrap mode (10497, 33071, 33648)");
+      };
+      out.wrap_u = wrap(s.wrapS, "wrapS");
+      out.wrap_v = wrap(s.wrapT, "wrapT");
+      switch (s.magFilter) {
+        case -1: case TINYGLTF_TEXTURE_FILTER_LINEAR: out.magnify = Filter::Bilinear; break;
+        case TINYGLTF_TEXTURE_FILTER_NEAREST: out.magnify = Filter::Nearest; break;
+        default: fail(path, where + ": sampler " + std::to_string(sampler) + " magFilter " + std::to_string(s.magFilter) +
+                                " is not a filter (9728, 9729)");
+      }
+      // The mip-mapped minifications are all trilinear here.
+      switch (s.minFilter) {
+        case TINYGLTF_TEXTURE_FILTER_NEAREST: out.filter = Filter::Nearest; break;
+        case TINYGLTF_TEXTURE_FILTER_LINEAR: out.filter = Filter::Bilinear; break;
+        case -1: case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST: case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+        case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR: case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR:
+          out.filter = Filter::Trilinear;
+          break;
+        default: fail(path, where + ": sampler " + std::to_string(sampler) + " minFilter " + std::to_string(s.minFilter) +
+                                " is not a filter (9728, 9729, 9984-9987)");
+      }
+    }
+    int set = info.texCoord;
+    const char* kTransform = "KHR_texture_transform";
+    if (info.extensions.count(kTransform)) {
+      const std::string field = where + ": " + kTransform + " ";
+      if (!extension_pair(info.extensions, kTransform, "offset", out.uv_offset)) fail(path, field + "offset must be 2 numbers");
+      if (!extension_pair(info.extensions, kTransform, "scale", out.uv_scale)) fail(path, field + "scale must be 2 numbers");
+      const double r = extension_number(info.extensions, kTransform, "rotation", 0.0);
+      if (!std::isfinite(r)) fail(path, field + "rotation must be a number");
+      out.uv_rotation = static_cast<float>(r);
+      const double tc = extension_number(info.extensions, kTransform, "texCoord", set);
+      if (!(tc == std::floor(tc))) fail(path, field + "texCoord must be a whole number");
+      set = static_cast<int>(std::clamp(tc, -1.0, 1e6));
+    }
+    if (set != 0 && set != 1) {
+      fail(path, where + ": texCoord " + std::to_string(set) + " is not supported (TEXCOORD_0 and TEXCOORD_1 are)");
+    }
+    uv_set = set;
+    return out;
+  }
+};
+
+MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t index) {
+  const std::string& path = images.mesh.source;
   MeshMaterial out;
   out.name = g.name.empty() ? "material " + std::to_string(index) : g.name;
   const std::string what = "material '" + out.name + "'";
@@ -552,7 +756,7 @@ MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g,
     if (!(v >= 0.0 && v <= 1.0)) fail(path, what + ": " + field + " must be in [0, 1]");
     return static_cast<float>(v);
   };
-  const double strength = extension_number(g, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
+  const double strength = extension_number(g.extensions, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
   if (!(strength >= 0.0 && strength <= kMaxRadiance)) {
     fail(path, what + ": KHR_materials_emissive_strength emissiveStrength must be a number in [0, 1e9]");
   }
@@ -560,14 +764,27 @@ MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g,
   if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > kMaxRadiance) {
     fail(path, what + ": emissiveFactor times emissiveStrength exceeds 1e9 (the most radiance a scene may hold)");
   }
-  const double ior = extension_number(g, "KHR_materials_ior", "ior", 1.5);
+  const double ior = extension_number(g.extensions, "KHR_materials_ior", "ior", 1.5);
   if (!(ior == 0.0 || (ior >= 1.0 && ior <= 10.0))) fail(path, what + ": KHR_materials_ior ior must be 0 or in [1, 10]");
+  // The texture coordinates of the material's first texture; another texture of it
+  // naming the other set is a warning (every texture reads the first's).
+  int first_set = -1;
+  auto texture = [&](const auto& info, const std::string& where) {
+    int set = 0;
+    MeshTexture t = images.texture(info, what + ": " + where, set);
+    if (first_set < 0) {
+      first_set = set;
+    } else if (set != first_set) {
+      images.mesh.warnings.push_back(what + ": its " + where + " reads TEXCOORD_" + std::to_string(set) +
+                                     ", another of its textures TEXCOORD_" + std::to_string(first_set) +
+                                     "; all read TEXCOORD_" + std::to_string(first_set));
+    }
+    out.uv_set = first_set;
+    return t;
+  };
   if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > 0.0f) {
     out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, emissive);
-    if (g.emissiveTexture.index >= 0) {
-      out.albedo_map = gltf_texture_file(model, g.emissiveTexture.index, g.emissiveTexture.texCoord,
-                                         what + ": emissive texture", dir, path);
-    }
+    if (g.emissiveTexture.index >= 0) out.albedo_map = texture(g.emissiveTexture, "emissive texture");
     return out;
   }
   out.material = make_material(MaterialKind::Principled, base, 0.0f, 1.0f, vec3(0.0f));
@@ -576,29 +793,34 @@ MeshMaterial map_gltf(const tinygltf::Model& model, const tinygltf::Material& g,
   out.material.ior = ior == 0.0 ? 1e4f : static_cast<float>(ior);
   out.material.flags = kMaterialCompensated | (g.doubleSided ? 0u : static_cast<uint32_t>(kMaterialOneSided));
   out.metallic = unit(pbr.metallicFactor, "metallicFactor");
-  out.specular = unit(extension_number(g, "KHR_materials_specular", "specularFactor", 1.0),
+  out.specular = unit(extension_number(g.extensions, "KHR_materials_specular", "specularFactor", 1.0),
                       "KHR_materials_specular specularFactor");
-  out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
-  if (pbr.baseColorTexture.index >= 0) {
-    out.albedo_map = gltf_texture_file(model, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                                       what + ": base colour texture", dir, path);
+  auto specular = g.extensions.find("KHR_materials_specular");
+  if (specular != g.extensions.end() && specular->second.IsObject()) {
+    for (const char* field : {"specularTexture", "specularColorFactor", "specularColorTexture"}) {
+      if (specular->second.Has(field)) {
+        images.mesh.warnings.push_back(what + ": KHR_materials_specular " + field + " is not read");
+      }
+    }
   }
+  out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  if (pbr.baseColorTexture.index >= 0) out.albedo_map = texture(pbr.baseColorTexture, "base colour texture");
   if (pbr.metallicRoughnessTexture.index >= 0) {
-    out.metallic_roughness_map =
-        gltf_texture_file(model, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                          what + ": metallic-roughness texture", dir, path);
+    out.metallic_roughness_map = texture(pbr.metallicRoughnessTexture, "metallic-roughness texture");
   }
   if (g.normalTexture.index >= 0) {
-    out.normal_map = gltf_texture_file(model, g.normalTexture.index, g.normalTexture.texCoord,
-                                       what + ": normal texture", dir, path);
+    out.normal_map = texture(g.normalTexture, "normal texture");
     if (!(g.normalTexture.scale >= 0.0 && g.normalTexture.scale <= 1e3)) {
       fail(path, what + ": normalTexture scale must be in [0, 1000]");
     }
     out.normal_scale = static_cast<float>(g.normalTexture.scale);
   }
   // Occlusion is read and checked, not applied: the paths find the occlusion.
-  if (g.occlusionTexture.index >= 0 && static_cast<size_t>(g.occlusionTexture.index) >= model.textures.size()) {
+  if (g.occlusionTexture.index >= 0 && static_cast<size_t>(g.occlusionTexture.index) >= images.model.textures.size()) {
     fail(path, what + ": occlusion texture index out of range");
+  }
+  if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) {
+    images.mesh.warnings.push_back(what + ": alphaMode " + g.alphaMode + " is not read yet; the surface is opaque");
   }
   return out;
 }
@@ -629,9 +851,10 @@ glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& path) 
 class GltfReader {
  public:
   GltfReader(const tinygltf::Model& model, const fs::path& dir, TriangleMesh& mesh)
-      : model_(model), mesh_(mesh), builder_(mesh) {
+      : model_(model), mesh_(mesh), builder_(mesh), images_{model, dir, mesh, {}} {
+    check_extensions(model, mesh);
     for (size_t i = 0; i < model.materials.size(); ++i) {
-      mesh.materials.push_back(map_gltf(model, model.materials[i], i, dir, mesh.source));
+      mesh.materials.push_back(map_gltf(images_, model.materials[i], i));
     }
   }
 
@@ -734,23 +957,9 @@ class GltfReader {
         auto it = prim.attributes.find(name);
         return it == prim.attributes.end() ? -1 : it->second;
       };
-      const int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-      if (attribute("POSITION") < 0) fail(path, what + ": no POSITION attribute");
-      Elements pos = elements(model_, attribute("POSITION"), what + " POSITION", TINYGLTF_TYPE_VEC3, {kFloat}, path);
-      Elements nrm, uv, tan;
-      if (attribute("TANGENT") >= 0) {
-        tan = elements(model_, attribute("TANGENT"), what + " TANGENT", TINYGLTF_TYPE_VEC4, {kFloat}, path);
-        if (tan.count != pos.count) fail(path, what + ": TANGENT and POSITION counts differ");
-      }
-      if (attribute("NORMAL") >= 0) {
-        nrm = elements(model_, attribute("NORMAL"), what + " NORMAL", TINYGLTF_TYPE_VEC3, {kFloat}, path);
-        if (nrm.count != pos.count) fail(path, what + ": NORMAL and POSITION counts differ");
-      }
-      if (attribute("TEXCOORD_0") >= 0) {
-        uv = elements(model_, attribute("TEXCOORD_0"), what + " TEXCOORD_0", TINYGLTF_TYPE_VEC2,
-                      {kFloat, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}, path);
-        if (uv.count != pos.count) fail(path, what + ": TEXCOORD_0 and POSITION counts differ");
-      }
+      const int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT, kByte = TINYGLTF_COMPONENT_TYPE_BYTE,
+                kUbyte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, kShort = TINYGLTF_COMPONENT_TYPE_SHORT,
+                kUshort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
       uint32_t material;
       if (prim.material >= 0) {
         if (static_cast<size_t>(prim.material) >= model_.materials.size()) fail(path, what + ": material index out of range");
@@ -764,45 +973,66 @@ class GltfReader {
           g.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
           g.pbrMetallicRoughness.metallicFactor = 1.0;
           g.pbrMetallicRoughness.roughnessFactor = 1.0;
-          return map_gltf(model_, g, 0, fs::path(), path);
+          return map_gltf(images_, g, 0);
         });
+      }
+      // Component types: the core's, and KHR_mesh_quantization's.
+      if (attribute("POSITION") < 0) fail(path, what + ": no POSITION attribute");
+      const std::vector<float> pos = read_accessor<float>(model_, attribute("POSITION"), what + " POSITION",
+                                                          TINYGLTF_TYPE_VEC3, {kFloat, kByte, kUbyte, kShort, kUshort}, path);
+      const size_t count = pos.size() / 3;
+      auto optional = [&](const std::string& name, int type, const std::vector<int>& components) {
+        std::vector<float> v;
+        if (attribute(name.c_str()) < 0) return v;
+        v = read_accessor<float>(model_, attribute(name.c_str()), what + " " + name, type, components, path);
+        if (v.size() / tinygltf::GetNumComponentsInType(type) != count) {
+          fail(path, what + ": " + name + " and POSITION counts differ");
+        }
+        return v;
+      };
+      const std::vector<float> tan = optional("TANGENT", TINYGLTF_TYPE_VEC4, {kFloat, kByte, kShort});
+      const std::vector<float> nrm = optional("NORMAL", TINYGLTF_TYPE_VEC3, {kFloat, kByte, kShort});
+      // The set of texture coordinates the material's textures read.
+      const int set = mesh_.materials[material].uv_set;
+      const std::string uv_name = "TEXCOORD_" + std::to_string(set);
+      const std::vector<float> uv = optional(uv_name, TINYGLTF_TYPE_VEC2, {kFloat, kByte, kUbyte, kShort, kUshort});
+      if (set != 0 && uv.empty()) {
+        fail(path, what + ": its material's textures read " + uv_name + ", which the primitive does not have");
       }
 
       const size_t first = mesh_.positions.size();
-      std::vector<vec3> world_pos(pos.count);
-      for (size_t i = 0; i < pos.count; ++i) {
-        glm::dvec4 p4 = world * glm::dvec4(component(pos, i, 0), component(pos, i, 1), component(pos, i, 2), 1.0);
+      std::vector<vec3> world_pos(count);
+      for (size_t i = 0; i < count; ++i) {
+        glm::dvec4 p4 = world * glm::dvec4(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2], 1.0);
         world_pos[i] = vec3(p4);
         vec3 n;
-        if (nrm.data) n = vec3(normal_matrix * glm::dvec3(component(nrm, i, 0), component(nrm, i, 1), component(nrm, i, 2)));
+        if (!nrm.empty()) n = vec3(normal_matrix * glm::dvec3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]));
         // glTF puts v = 0 at the image's top row, as a mesh's UVs do.
-        vec2 tc = uv.data ? vec2(component(uv, i, 0), component(uv, i, 1)) : vec2(0.0f);
+        vec2 tc = uv.empty() ? vec2(0.0f) : vec2(uv[2 * i], uv[2 * i + 1]);
         // Tangents turn with the node as directions do; a mirroring node flips
         // the handedness.
         vec4 tg(0.0f);
-        if (tan.data) {
-          tg = vec4(vec3(glm::dmat3(world) * glm::dvec3(component(tan, i, 0), component(tan, i, 1), component(tan, i, 2))),
-                    component(tan, i, 3) * (mirrors ? -1.0f : 1.0f));
+        if (!tan.empty()) {
+          tg = vec4(vec3(glm::dmat3(world) * glm::dvec3(tan[4 * i], tan[4 * i + 1], tan[4 * i + 2])),
+                    tan[4 * i + 3] * (mirrors ? -1.0f : 1.0f));
         }
-        builder_.add_vertex(world_pos[i], nrm.data ? &n : nullptr, uv.data ? &tc : nullptr, tan.data ? &tg : nullptr);
+        builder_.add_vertex(world_pos[i], nrm.empty() ? nullptr : &n, uv.empty() ? nullptr : &tc,
+                            tan.empty() ? nullptr : &tg);
       }
 
-      Elements idx;
-      size_t corners = pos.count;
+      std::vector<uint32_t> idx;
       if (prim.indices >= 0) {
-        idx = elements(model_, prim.indices, what + " indices", TINYGLTF_TYPE_SCALAR,
-                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                       path);
-        corners = idx.count;
+        idx = read_accessor<uint32_t>(model_, prim.indices, what + " indices", TINYGLTF_TYPE_SCALAR,
+                                      {kUbyte, kUshort, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT}, path);
       }
+      const size_t corners = prim.indices >= 0 ? idx.size() : count;
       if (corners % 3 != 0) fail(path, what + ": " + std::to_string(corners) + " corners is not a multiple of 3");
       for (size_t t = 0; t < corners / 3; ++t) {
         uint32_t c[3];
         for (int k = 0; k < 3; ++k) {
-          c[k] = idx.data ? index_at(idx, 3 * t + k) : static_cast<uint32_t>(3 * t + k);
-          if (c[k] >= pos.count) {
-            fail(path, what + ": index " + std::to_string(c[k]) + " out of range (" + std::to_string(pos.count) +
+          c[k] = prim.indices >= 0 ? idx[3 * t + k] : static_cast<uint32_t>(3 * t + k);
+          if (c[k] >= count) {
+            fail(path, what + ": index " + std::to_string(c[k]) + " out of range (" + std::to_string(count) +
                            " vertices)");
           }
         }
@@ -816,11 +1046,17 @@ class GltfReader {
   const tinygltf::Model& model_;
   TriangleMesh& mesh_;
   MeshBuilder builder_;
+  GltfImages images_;
   int64_t default_ = -1;
 };
 
-// Images are not decoded here: only their file names are kept.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// tinygltf's image callback, given a data URI's bytes (decoded from base64) or a
+// buffer view's. Nothing is decoded here: a data URI's bytes are kept in the image
+// for GltfImages; a buffer view's are taken there, once its range is checked
+// (tinygltf hands them over unchecked, and they are not read here).
+bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int, const unsigned char* bytes,
+                int size, void*) {
+  if (image->bufferView < 0 && size > 0) image->image.assign(bytes, bytes + size);
   return true;
 }
 
@@ -855,7 +1091,7 @@ struct GltfFiles {
 void load_gltf(const std::string& bytes, bool binary, const fs::path& dir, TriangleMesh& mesh) {
   if (bytes.size() > std::numeric_limits<unsigned int>::max()) fail(mesh.source, "file too large for tinygltf");
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
+  loader.SetImageLoader(keep_image, nullptr);
   GltfFiles files;
   loader.SetFsCallbacks({&GltfFiles::exists, &GltfFiles::expand, &GltfFiles::read, &GltfFiles::write, &files});
   tinygltf::Model model;

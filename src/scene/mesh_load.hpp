@@ -11,23 +11,48 @@
 #include <vector>
 
 #include "wavetrace/material.hpp"
+#include "wavetrace/texture.hpp"
 
 namespace wt {
+
+// A material's texture as the file gives it: its image, how it is sampled (glTF's
+// sampler) and its UV transform (KHR_texture_transform, as Texture holds it).
+struct MeshTexture {
+  // The image's file, resolved against the mesh file's folder; or, for an image
+  // embedded in the mesh file (a .glb buffer view, a data URI), a key
+  // "<mesh file>#images[N]" of TriangleMesh::embedded. "" for none.
+  std::string image;
+  Wrap wrap_u = Wrap::Repeat, wrap_v = Wrap::Repeat;
+  Filter filter = Filter::Trilinear;   // minified
+  Filter magnify = Filter::Bilinear;   // magnified (Bilinear or Nearest)
+  vec2 uv_offset{0.0f}, uv_scale{1.0f};
+  float uv_rotation = 0.0f;  // radians
+  bool empty() const { return image.empty(); }
+};
 
 // One of the file's materials, mapped onto a wavetrace Material.
 struct MeshMaterial {
   std::string name;        // as the file names it ("default" for faces without one)
   Material material{};     // texture < 0; sort_key set as for an untextured material
-  // The albedo texture's file (an emitter's: its emission's), resolved against the
-  // mesh file's folder; "" for none.
-  std::string albedo_map;
-  // `principled` (glTF's metallic-roughness): its factors, and the files of its
+  // The albedo texture (an emitter's: its emission's), sRGB.
+  MeshTexture albedo_map;
+  // `principled` (glTF's metallic-roughness): its factors, and its
   // metallic-roughness texture (G roughness, B metallic) and tangent-space normal
-  // map (both linear; "" for none), the normal map's x and y scaled by normal_scale.
+  // map (both linear), the normal map's x and y scaled by normal_scale.
   float roughness = 1.0f, metallic = 0.0f;
   float specular = 1.0f;  // KHR_materials_specular's specularFactor
-  std::string metallic_roughness_map, normal_map;
+  MeshTexture metallic_roughness_map, normal_map;
   float normal_scale = 1.0f;
+  // The texture coordinates its textures read (glTF: 0 for TEXCOORD_0, 1 for
+  // TEXCOORD_1); the mesh's uvs hold that set for this material's triangles.
+  int uv_set = 0;
+};
+
+// An image held inside a mesh file: its key (MeshTexture::image) and its encoded
+// bytes (PNG, JPEG, ...: decoded as image files are).
+struct EmbeddedImage {
+  std::string key;
+  std::string bytes;
 };
 
 struct TriangleMesh {
@@ -41,6 +66,10 @@ struct TriangleMesh {
   std::vector<std::array<uint32_t, 3>> triangles;  // vertex indices
   std::vector<uint32_t> triangle_material;         // per triangle, an index into materials
   std::vector<MeshMaterial> materials;
+  std::vector<EmbeddedImage> embedded;  // the images its textures name by key
+  // What the file holds that is not rendered (an extension it uses that wavetrace
+  // does not read), one line each; the scene counts and prints them.
+  std::vector<std::string> warnings;
   size_t dropped_degenerate = 0;  // zero-area triangles (and faces of fewer than 3 corners)
   size_t dropped_nan = 0;         // triangles with a non-finite position
 };

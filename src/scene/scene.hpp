@@ -53,6 +53,7 @@ struct SceneMesh {
   uint32_t triangle_count = 0;
   size_t dropped_degenerate = 0;  // triangles the loader dropped (mesh_load.hpp)
   size_t dropped_nan = 0;
+  std::vector<std::string> warnings;  // what the file holds that is not rendered (mesh_load.hpp)
   BvhStats bvh;
 };
 

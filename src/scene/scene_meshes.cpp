@@ -81,9 +81,19 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
     for (size_t i = 0; i < mesh.materials.size(); ++i) {
       const MeshMaterial& mm = mesh.materials[i];
       Material m = mm.material;
-      // Both axes repeat, as glTF's default sampler and OBJ's maps do.
-      auto texture_of = [&](const std::string& file, bool srgb) {
-        scene_.textures.push_back(image_texture(image_file(file, srgb, mesh.source), Wrap::Repeat, Wrap::Repeat));
+      // As the file samples it (OBJ's maps, and glTF's default sampler, repeat on
+      // both axes), its image a file or one the mesh file holds.
+      auto texture_of = [&](const MeshTexture& mt, bool srgb) {
+        const std::string* embedded = nullptr;
+        for (const EmbeddedImage& e : mesh.embedded) embedded = e.key == mt.image ? &e.bytes : embedded;
+        Texture t = image_texture(image_file(mt.image, srgb, mesh.source, embedded), mt.wrap_u, mt.wrap_v);
+        t.filter = mt.filter;
+        t.magnify = mt.magnify;
+        t.uv_offset = mt.uv_offset;
+        t.uv_scale = mt.uv_scale;
+        t.uv_cos = std::cos(mt.uv_rotation);
+        t.uv_sin = std::sin(mt.uv_rotation);
+        scene_.textures.push_back(t);
         return static_cast<int32_t>(scene_.textures.size() - 1);
       };
       if (!mm.albedo_map.empty()) {
@@ -120,6 +130,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   sm.triangle_count = static_cast<uint32_t>(mesh.triangles.size());
   sm.dropped_degenerate = mesh.dropped_degenerate;
   sm.dropped_nan = mesh.dropped_nan;
+  sm.warnings = mesh.warnings;
   // Normals and UVs are stored per vertex where the mesh has them; a triangle's
   // indices point into whichever the mesh has (both arrays grow alike).
   const bool normals = !mesh.normals.empty(), uvs = !mesh.uvs.empty();

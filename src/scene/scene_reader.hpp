@@ -61,10 +61,12 @@ class SceneReader : JsonReader {
   // Textures that name the same file in the same colorspace share one image.
   // `file` relative to the scene file; an error names the field.
   int32_t image(const std::string& file, bool srgb, const JsonPath& path);
-  // `resolved` as it is; an error names `referrer` (a mesh file whose material uses it).
-  int32_t image_file(const std::string& resolved, bool srgb, const std::string& referrer);
+  // `resolved` as it is; an error names `referrer` (a mesh file whose material uses
+  // it). `embedded`: the encoded bytes of an image held in that file, `resolved` its key.
+  int32_t image_file(const std::string& resolved, bool srgb, const std::string& referrer,
+                     const std::string* embedded = nullptr);
   // The image's index, or -1 with the reason in `why`.
-  int32_t image_at(const std::string& resolved, bool srgb, std::string& why);
+  int32_t image_at(const std::string& resolved, bool srgb, std::string& why, const std::string* embedded = nullptr);
 
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);

@@ -46,7 +46,8 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
                {"name", "type", "file", "colorspace", "uv_offset", "uv_scale", "uv_rotation", "wrap", "filter"},
                "image");
     if (j.contains("filter")) {
-      t.filter = static_cast<Filter>(choice(j["filter"], path / "filter", {"bilinear", "trilinear"}));
+      t.filter = static_cast<Filter>(choice(j["filter"], path / "filter", {"bilinear", "trilinear", "nearest"}));
+      if (t.filter == Filter::Nearest) t.magnify = Filter::Nearest;
     }
     t.kind = TextureKind::Image;
     if (j.contains("uv_offset")) t.uv_offset = pair(j["uv_offset"], path / "uv_offset");
@@ -88,9 +89,10 @@ int32_t SceneReader::image(const std::string& file, bool srgb, const JsonPath& p
   return index;
 }
 
-int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const std::string& referrer) {
+int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const std::string& referrer,
+                                const std::string* embedded) {
   std::string why;
-  int32_t index = image_at(resolved, srgb, why);
+  int32_t index = image_at(resolved, srgb, why, embedded);
   if (index < 0) throw InputError(referrer + ": cannot read texture image '" + resolved + "' (" + why + ")");
   return index;
 }
@@ -158,22 +160,23 @@ struct StbBytes {
 
   bool load(const std::string& path, std::string& why) {
     if (!read_image_file(path, bytes, why)) return false;
+    take();
+    return true;
+  }
+  // `bytes` set: notes whether they are Radiance data.
+  void take() {
     pad = stbi_is_hdr_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), static_cast<int>(std::min<size_t>(
                                                                                       bytes.size(), INT32_MAX))) != 0;
-    return true;
   }
 };
 
-// Decodes `path` with one of stb's callback loaders (stbi_loadf_from_callbacks,
+// Decodes a file's bytes with one of stb's callback loaders (stbi_loadf_from_callbacks,
 // stbi_load_from_callbacks) over StbBytes, in the file's own channels. Null with the
 // reason when stb refuses the file, saying so where the file ended before the decoder
 // was done, or where a Radiance decode needed bytes past its end.
 template <class Texel>
-Texel* decode_with_stb(const std::string& path,
-                       Texel* (*load)(const stbi_io_callbacks*, void*, int*, int*, int*, int), int& w, int& h,
-                       int& channels, std::string& why) {
-  StbBytes file;
-  if (!file.load(path, why)) return nullptr;
+Texel* decode_with_stb(StbBytes& file, Texel* (*load)(const stbi_io_callbacks*, void*, int*, int*, int*, int), int& w,
+                       int& h, int& channels, std::string& why) {
   const stbi_io_callbacks callbacks{&StbBytes::read, &StbBytes::skip, &StbBytes::eof};
   Texel* data = load(&callbacks, &file, &w, &h, &channels, 0);
   if (!data) {
@@ -199,9 +202,9 @@ Texel* decode_with_stb(const std::string& path,
 }
 
 // A Radiance .hdr file through stb, widened to RGBA (alpha 1). False with the reason.
-bool read_hdr(const std::string& path, Image& im, std::string& why) {
+bool read_hdr(StbBytes& file, Image& im, std::string& why) {
   int w = 0, h = 0, channels = 0;
-  float* data = decode_with_stb(path, &stbi_loadf_from_callbacks, w, h, channels, why);
+  float* data = decode_with_stb(file, &stbi_loadf_from_callbacks, w, h, channels, why);
   if (!data) return false;
   im.width = w;
   im.height = h;
@@ -219,9 +222,9 @@ bool read_hdr(const std::string& path, Image& im, std::string& why) {
 // (stb 2.27, Debian bookworm, reads past its buffer when it converts a 16-bit PNM
 // to 4 channels), decoded from sRGB where `srgb` says. Radiance data under another
 // name (stb reads by content) is padded as read_hdr's is. False with the reason.
-bool read_8bit(const std::string& path, bool srgb, Image& im, std::string& why) {
+bool read_8bit(StbBytes& file, bool srgb, Image& im, std::string& why) {
   int w = 0, h = 0, channels = 0;
-  stbi_uc* data = decode_with_stb(path, &stbi_load_from_callbacks, w, h, channels, why);
+  stbi_uc* data = decode_with_stb(file, &stbi_load_from_callbacks, w, h, channels, why);
   if (!data) return false;
   im.width = w;
   im.height = h;
@@ -320,18 +323,30 @@ bool check_radiance(const Image& im, std::string& why) {
 
 }  // namespace
 
-int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::string& why) {
+int32_t SceneReader::image_at(const std::string& resolved, bool srgb, std::string& why, const std::string* embedded) {
   auto known = images_.find({resolved, srgb});
   if (known != images_.end()) return known->second;
 
   const auto start = Clock::now();
   Image im;
   im.path = resolved;
-  // Radiance .hdr and OpenEXR files hold linear values, whatever the colorspace says.
-  const std::string ext = lower_extension(resolved);
-  const bool read = ext == ".hdr"   ? read_hdr(resolved, im, why) && check_radiance(im, why)
-                    : ext == ".exr" ? read_exr(resolved, im, why) && check_radiance(im, why)
-                                    : read_8bit(resolved, srgb, im, why);
+  // Radiance .hdr and OpenEXR files hold linear values, whatever the colorspace
+  // says. An embedded image (a mesh file's) is 8-bit.
+  const std::string ext = embedded ? std::string() : lower_extension(resolved);
+  bool read;
+  if (ext == ".exr") {
+    read = read_exr(resolved, im, why) && check_radiance(im, why);
+  } else {
+    StbBytes file;
+    if (embedded) {
+      file.bytes = *embedded;
+      file.take();
+      read = true;
+    } else {
+      read = file.load(resolved, why);
+    }
+    read = read && (ext == ".hdr" ? read_hdr(file, im, why) && check_radiance(im, why) : read_8bit(file, srgb, im, why));
+  }
   if (!read) return -1;
   im.srgb_decoded = srgb && ext != ".hdr" && ext != ".exr";
   texture_seconds_ += seconds_since(start);

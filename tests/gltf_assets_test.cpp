@@ -1,0 +1,400 @@
+// glTF assets as their authors make them (issue 24): images embedded in a .glb's
+// buffer views and in data URIs decode as their .png twins do and render the same
+// image; samplers' wrap and filter modes, KHR_texture_transform and TEXCOORD_1 reach
+// the textures; quantized and sparse accessors decode; the extensions a file
+// requires or uses are refused or counted; bad embedded images are one line each.
+#include <gtest/gtest.h>
+
+#include <stb/stb_image_write.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "dispatch/renderer.hpp"
+#include "errors/errors.hpp"
+#include "render_support.hpp"
+#include "scene/mesh_load.hpp"
+#include "scene/scene.hpp"
+#include "test_support.hpp"
+#include "wavetrace/texture.hpp"
+
+// tinygltf's own encoder (compiled in src/scene/mesh_libraries.cpp), for data URIs.
+namespace tinygltf {
+std::string base64_encode(unsigned char const* bytes, unsigned int len);
+}
+
+namespace wt {
+namespace {
+
+using nlohmann::json;
+
+std::string base64(const std::string& bytes) {
+  return tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                 static_cast<unsigned>(bytes.size()));
+}
+
+template <class T>
+std::string bytes_of(const std::vector<T>& v) {
+  return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+// A glTF document built here: one binary buffer of views, accessors over them, and
+// a unit quad in z = 0 (facing +z) whose one primitive uses material 0.
+struct Doc {
+  json j;
+  std::string bin;
+
+  Doc() {
+    j = {{"asset", {{"version", "2.0"}}}, {"scene", 0}, {"scenes", {{{"nodes", {0}}}}},
+         {"nodes", {{{"mesh", 0}}}}, {"bufferViews", json::array()}, {"accessors", json::array()}};
+    const std::vector<float> p = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const std::vector<float> n = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const std::vector<float> uv0 = {0, 1, 1, 1, 1, 0, 0, 0};
+    const std::vector<float> uv1 = {0.5f, 0.5f, 0.75f, 0.5f, 0.75f, 0.25f, 0.5f, 0.25f};
+    const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+    json attributes = {{"POSITION", accessor(view(bytes_of(p)), 5126, 4, "VEC3")},
+                       {"NORMAL", accessor(view(bytes_of(n)), 5126, 4, "VEC3")},
+                       {"TEXCOORD_0", accessor(view(bytes_of(uv0)), 5126, 4, "VEC2")},
+                       {"TEXCOORD_1", accessor(view(bytes_of(uv1)), 5126, 4, "VEC2")}};
+    j["meshes"] = {{{"primitives", {{{"attributes", attributes},
+                                    {"indices", accessor(view(bytes_of(idx)), 5123, 6, "SCALAR")},
+                                    {"material", 0}}}}}};
+    j["materials"] = {{{"pbrMetallicRoughness", {{"metallicFactor", 0}}}}};
+  }
+
+  int view(const std::string& bytes) {
+    while (bin.size() % 4) bin.push_back('\0');
+    j["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes.size()}});
+    bin += bytes;
+    return static_cast<int>(j["bufferViews"].size()) - 1;
+  }
+  int accessor(int view_index, int component, size_t count, const char* type, bool normalized = false) {
+    json a = {{"bufferView", view_index}, {"componentType", component}, {"count", count}, {"type", type}};
+    if (normalized) a["normalized"] = true;
+    j["accessors"].push_back(a);
+    return static_cast<int>(j["accessors"].size()) - 1;
+  }
+  // The base colour texture: image `image`, with `info`'s extra fields.
+  void base_colour(const json& image, const json& info = json::object(), const json& sampler = json()) {
+    json tex = {{"source", 0}};
+    if (!sampler.is_null()) {
+      j["samplers"] = {sampler};
+      tex["sampler"] = 0;
+    }
+    j["textures"] = {tex};
+    j["images"] = {image};
+    json i = info;
+    i["index"] = 0;
+    j["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = i;
+  }
+
+  // As .gltf, the buffer a data URI.
+  std::string gltf() const {
+    json out = j;
+    out["buffers"] = {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}};
+    return out.dump();
+  }
+  // As .glb: header, JSON chunk (space-padded), BIN chunk.
+  std::string glb() const {
+    json out = j;
+    std::string b = bin;
+    while (b.size() % 4) b.push_back('\0');
+    out["buffers"] = {{{"byteLength", b.size()}}};
+    std::string text = out.dump();
+    while (text.size() % 4) text.push_back(' ');
+    auto u32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+    std::string s = "glTF" + u32(2) + u32(static_cast<uint32_t>(12 + 8 + text.size() + 8 + b.size()));
+    s += u32(static_cast<uint32_t>(text.size())) + "JSON" + text;
+    s += u32(static_cast<uint32_t>(b.size())) + "BIN" + std::string(1, '\0') + b;
+    return s;
+  }
+};
+
+// A 4 x 4 RGBA PNG: a grey ramp with one red texel at (1, 2).
+std::string marked_png() {
+  std::vector<unsigned char> px(4 * 4 * 4);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) {
+      unsigned char* p = &px[4 * (4 * y + x)];
+      const unsigned char g = static_cast<unsigned char>(40 + 12 * (4 * y + x));
+      p[0] = p[1] = p[2] = g;
+      p[3] = 255;
+      if (x == 1 && y == 2) p[1] = p[2] = 0, p[0] = 255;
+    }
+  }
+  std::string out;
+  auto append = [](void* ctx, void* data, int size) {
+    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
+  };
+  EXPECT_NE(stbi_write_png_to_func(append, &out, 4, 4, 4, px.data(), 16), 0);
+  return out;
+}
+
+// The red texel, decoded from sRGB (to rounding).
+bool is_red(const vec3& c) { return c.x > 0.999f && c.y == 0.0f && c.z == 0.0f; }
+
+class GltfAssets : public ::testing::Test {
+ protected:
+  std::string write(const std::string& name, const std::string& bytes) {
+    const std::string path = (folder_.root() / name).string();
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  }
+  // A scene of the mesh file facing the camera, lit by a white sky.
+  Scene scene_of(const std::string& mesh_file) {
+    write("scene.json", R"({"camera": {"look_from": [0.5, 0.5, 2], "look_at": [0.5, 0.5, 0], "vfov": 40},
+      "sky": {"type": "uniform", "radiance": [1, 1, 1]}, "materials": [],
+      "meshes": [{"name": "m", "file": ")" + mesh_file + R"("}], "instances": [{"mesh": "m"}]})");
+    return load_scene((folder_.root() / "scene.json").string());
+  }
+  // The scene's texture t looked up at uv (no footprint: the magnified lookup).
+  vec3 lookup(const Scene& scene, int32_t t, vec2 uv) {
+    std::vector<ImageView> views;
+    host_view(scene, 8, 8, views);
+    SurfacePoint sp{};
+    sp.has_uv = true;
+    sp.uv = uv;
+    return eval_texture(scene.textures.at(t), views.data(), sp);
+  }
+  void expect_error(const std::string& path, const std::string& what, bool scene = false) {
+    try {
+      if (scene) {
+        scene_of(path);
+      } else {
+        load_mesh(path);
+      }
+      ADD_FAILURE() << path << " loaded; expected: " << what;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(path + ": "), std::string::npos) << message;
+      EXPECT_NE(message.find(what), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
+  test::TestFolder folder_;
+};
+
+// The same image beside the file, in the .glb's binary buffer and in a data URI:
+// the same texels, and the same rendered image to the last bit.
+TEST_F(GltfAssets, EmbeddedImagesDecodeAndRenderAsTheirFileTwin) {
+  const std::string png = marked_png();
+  write("marked.png", png);
+  Doc file, glb, datauri;
+  file.base_colour({{"uri", "marked.png"}});
+  glb.base_colour({{"bufferView", glb.view(png)}, {"mimeType", "image/png"}});
+  datauri.base_colour({{"uri", "data:image/png;base64," + base64(png)}});
+  write("file.gltf", file.gltf());
+  write("embedded.glb", glb.glb());
+  write("datauri.gltf", datauri.gltf());
+
+  const TriangleMesh m = load_mesh((folder_.root() / "embedded.glb").string());
+  ASSERT_EQ(m.embedded.size(), 1u);
+  EXPECT_EQ(m.materials.at(0).albedo_map.image, m.source + "#images[0]");
+  EXPECT_EQ(m.embedded[0].bytes, png);
+
+  std::vector<RenderResult> renders;
+  std::vector<std::vector<float>> texels;
+  for (const char* f : {"file.gltf", "embedded.glb", "datauri.gltf"}) {
+    const Scene scene = scene_of(f);
+    ASSERT_EQ(scene.images.size(), 1u) << f;
+    texels.push_back(scene.images[0].texels);
+    RenderOptions o = test::options_for(Backend::Cpu, Kernel::Megakernel, 24, 16, 4, 4, 100, 7);
+    renders.push_back(render(scene, o));
+  }
+  ASSERT_EQ(texels[0].size(), 4u * 4 * 4);
+  for (size_t i = 1; i < renders.size(); ++i) {
+    EXPECT_EQ(texels[i], texels[0]) << i;
+    EXPECT_EQ(renders[i].rgb, renders[0].rgb) << i;
+  }
+  // The texture is seen: the red texel makes the image's red mean exceed its green.
+  double red = 0, green = 0;
+  for (size_t i = 0; i < renders[0].rgb.size(); i += 3) red += renders[0].rgb[i], green += renders[0].rgb[i + 1];
+  EXPECT_GT(red, green * 1.01);
+}
+
+// A sampler's wrap modes and filters reach the scene's texture; NEAREST reads one
+// texel where LINEAR blends four.
+TEST_F(GltfAssets, SamplerWrapAndFilterReachTheTexture) {
+  write("marked.png", marked_png());
+  Doc d;
+  d.base_colour({{"uri", "marked.png"}}, json::object(),
+                {{"wrapS", 33071}, {"wrapT", 33648}, {"magFilter", 9728}, {"minFilter", 9729}});
+  const Scene scene = scene_of(write("sampled.gltf", d.gltf()));
+  const int32_t t = scene.materials.at(0).texture;
+  ASSERT_GE(t, 0);
+  const Texture& tex = scene.textures[t];
+  EXPECT_EQ(tex.wrap_u, Wrap::Clamp);
+  EXPECT_EQ(tex.wrap_v, Wrap::Mirror);
+  EXPECT_EQ(tex.magnify, Filter::Nearest);
+  EXPECT_EQ(tex.filter, Filter::Bilinear);
+  // Nearest: anywhere inside texel (1, 2) is that texel's red, even by its edge.
+  EXPECT_TRUE(is_red(lookup(scene, t, vec2(0.26f, 0.74f))));
+  EXPECT_TRUE(is_red(lookup(scene, t, vec2(0.49f, 0.51f))));
+  // Clamped in u: far right is column 3; mirrored in v: v = 1.375 is row 2 (0.625).
+  EXPECT_EQ(lookup(scene, t, vec2(7.0f, 0.1f)), lookup(scene, t, vec2(0.9f, 0.1f)));
+  EXPECT_TRUE(is_red(lookup(scene, t, vec2(0.3f, 1.375f))));
+
+  Doc bad;
+  bad.base_colour({{"uri", "marked.png"}}, json::object(), {{"wrapS", 1234}});
+  expect_error(write("bad-wrap.gltf", bad.gltf()), "sampler 0 wrapS 1234 is not a wrap mode");
+}
+
+// KHR_texture_transform (offset, then rotation, then scale, as the extension orders
+// them) moves the red texel: at uv' = offset + R(rotation) (scale uv).
+TEST_F(GltfAssets, TextureTransformMovesATexelWhereExpected) {
+  write("marked.png", marked_png());
+  const json nearest = {{"magFilter", 9728}, {"minFilter", 9728}};
+  const vec2 centre(1.5f / 4, 2.5f / 4);  // the red texel's centre
+  {
+    Doc d;
+    d.base_colour({{"uri", "marked.png"}},
+                  {{"extensions", {{"KHR_texture_transform", {{"offset", {0.25, 0}}, {"scale", {2, 2}}}}}}}, nearest);
+    const Scene scene = scene_of(write("moved.gltf", d.gltf()));
+    const int32_t t = scene.materials.at(0).texture;
+    EXPECT_TRUE(is_red(lookup(scene, t, (centre - vec2(0.25f, 0.0f)) / 2.0f)));
+    EXPECT_FALSE(is_red(lookup(scene, t, centre)));
+  }
+  {
+    // The extension's own example: offset (0, 1), a quarter turn, scale 0.5 shows
+    // the image's lower-left quadrant: uv (u, v) reads (v / 2, 1 - u / 2).
+    Doc d;
+    d.base_colour({{"uri", "marked.png"}},
+                  {{"extensions",
+                    {{"KHR_texture_transform", {{"offset", {0, 1}}, {"rotation", 1.57079632679}, {"scale", {0.5, 0.5}}}}}}},
+                  nearest);
+    const Scene scene = scene_of(write("turned.gltf", d.gltf()));
+    const int32_t t = scene.materials.at(0).texture;
+    // The red texel (u' 0.375, v' 0.625) is at u = 2 (1 - v') = 0.75, v = 2 u' = 0.75.
+    EXPECT_TRUE(is_red(lookup(scene, t, vec2(0.75f, 0.75f))));
+  }
+  Doc bad;
+  bad.base_colour({{"uri", "marked.png"}}, {{"extensions", {{"KHR_texture_transform", {{"scale", {1, "x"}}}}}}});
+  expect_error(write("bad-transform.gltf", bad.gltf()), "KHR_texture_transform scale must be 2 numbers");
+}
+
+// A material whose textures name texCoord 1 (or whose transform does) has the
+// mesh's TEXCOORD_1 as its UVs; one naming a set the primitive lacks is refused.
+TEST_F(GltfAssets, TexCoord1IsReadWhereTheTexturesNameIt) {
+  const std::vector<vec2> uv1 = {{0.5f, 0.5f}, {0.75f, 0.5f}, {0.75f, 0.25f}, {0.5f, 0.25f}};
+  for (const json& info : {json{{"texCoord", 1}},
+                           json{{"extensions", {{"KHR_texture_transform", {{"texCoord", 1}}}}}}}) {
+    Doc d;
+    d.base_colour({{"uri", "marked.png"}}, info);
+    const TriangleMesh m = load_mesh(write("uv1.gltf", d.gltf()));
+    EXPECT_EQ(m.materials.at(0).uv_set, 1);
+    ASSERT_EQ(m.uvs.size(), 4u);
+    for (size_t i = 0; i < 4; ++i) EXPECT_EQ(m.uvs[i], uv1[i]) << i;
+  }
+  Doc plain;
+  plain.base_colour({{"uri", "marked.png"}});
+  EXPECT_EQ(load_mesh(write("uv0.gltf", plain.gltf())).uvs.at(1), vec2(1.0f, 1.0f));
+
+  Doc missing;
+  missing.base_colour({{"uri", "marked.png"}}, {{"texCoord", 1}});
+  missing.j["meshes"][0]["primitives"][0]["attributes"].erase("TEXCOORD_1");
+  expect_error(write("no-uv1.gltf", missing.gltf()), "textures read TEXCOORD_1, which the primitive does not have");
+  Doc two;
+  two.base_colour({{"uri", "marked.png"}}, {{"texCoord", 2}});
+  expect_error(write("uv2.gltf", two.gltf()), "texCoord 2 is not supported");
+}
+
+// KHR_mesh_quantization's component types decode as the specification maps them,
+// and a sparse accessor's values replace the elements it names.
+TEST_F(GltfAssets, QuantizedAndSparseAccessorsDecode) {
+  Doc d;
+  json& attributes = d.j["meshes"][0]["primitives"][0]["attributes"];
+  // Positions as shorts (not normalized), normals as normalized bytes, UVs as
+  // normalized unsigned shorts.
+  const std::vector<int16_t> p = {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0};
+  const std::vector<int8_t> n = {0, 0, 127, 0, 0, 127, 0, 0, 127, 0, -128, 127};
+  const std::vector<uint16_t> uv = {0, 65535, 65535, 65535, 65535, 0, 0, 0};
+  attributes["POSITION"] = d.accessor(d.view(bytes_of(p)), 5122, 4, "VEC3");
+  attributes["NORMAL"] = d.accessor(d.view(bytes_of(n)), 5120, 4, "VEC3", true);
+  attributes["TEXCOORD_0"] = d.accessor(d.view(bytes_of(uv)), 5123, 4, "VEC2", true);
+  // Vertex 2 moved to (3, 3, 0) by a sparse substitution on a float copy.
+  const std::vector<float> pf = {0, 0, 0, 2, 0, 0, 2, 2, 0, 0, 2, 0};
+  const int dense = d.accessor(d.view(bytes_of(pf)), 5126, 4, "VEC3");
+  const std::vector<uint8_t> at = {2};
+  const std::vector<float> value = {3, 3, 0};
+  d.j["accessors"][dense]["sparse"] = {{"count", 1},
+                                       {"indices", {{"bufferView", d.view(bytes_of(at))}, {"componentType", 5121}}},
+                                       {"values", {{"bufferView", d.view(bytes_of(value))}}}};
+  d.j["extensionsUsed"] = {"KHR_mesh_quantization"};
+  d.j["extensionsRequired"] = {"KHR_mesh_quantization"};
+  const TriangleMesh q = load_mesh(write("quantized.gltf", d.gltf()));
+  ASSERT_EQ(q.positions.size(), 4u);
+  EXPECT_EQ(q.positions[2], vec3(2, 2, 0));
+  EXPECT_EQ(q.normals[0], vec3(0, 0, 1));
+  EXPECT_EQ(q.uvs[1], vec2(1, 1));
+  EXPECT_TRUE(q.warnings.empty());
+
+  attributes["POSITION"] = dense;
+  const TriangleMesh s = load_mesh(write("sparse.gltf", d.gltf()));
+  EXPECT_EQ(s.positions[1], vec3(2, 0, 0));
+  EXPECT_EQ(s.positions[2], vec3(3, 3, 0));
+
+  d.j["accessors"][dense]["sparse"]["count"] = 2;  // its index view holds one
+  expect_error(write("short-sparse.gltf", d.gltf()), "POSITION (accessor " + std::to_string(dense) +
+                                                         ") sparse indices: elements run past the end of the buffer view");
+}
+
+// An extension the file requires and wavetrace does not read is refused; one it only
+// uses is a warning that the scene counts.
+TEST_F(GltfAssets, RequiredExtensionsAreRefusedAndUsedOnesCounted) {
+  Doc d;
+  d.j["extensionsUsed"] = {"KHR_materials_sheen", "KHR_texture_transform"};
+  const TriangleMesh m = load_mesh(write("used.gltf", d.gltf()));
+  ASSERT_EQ(m.warnings.size(), 1u);
+  EXPECT_NE(m.warnings[0].find("KHR_materials_sheen is used but not read"), std::string::npos) << m.warnings[0];
+  const Scene scene = scene_of("used.gltf");
+  EXPECT_EQ(scene.summary().meshes.at(0).warnings, m.warnings);
+
+  d.j["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  expect_error(write("required.gltf", d.gltf()),
+               "the file requires the extension KHR_draco_mesh_compression (compressed geometry), which wavetrace does "
+               "not read");
+}
+
+// Each bad embedded image is one line naming the mesh file and the image; a scene
+// that uses it writes nothing (its error comes before rendering).
+TEST_F(GltfAssets, BadEmbeddedImagesAreOneLineErrors) {
+  const std::string png = marked_png();
+  {
+    Doc d;  // an image whose buffer view does not exist
+    d.base_colour({{"bufferView", 99}, {"mimeType", "image/png"}});
+    expect_error(write("missing.glb", d.glb()), "malformed glTF: image[0] bufferView");
+  }
+  {
+    Doc d;  // a buffer view past the end of the buffer
+    const int v = d.view(png);
+    d.j["bufferViews"][v]["byteLength"] = png.size() + 4096;
+    d.base_colour({{"bufferView", v}, {"mimeType", "image/png"}});
+    expect_error(write("past-end.glb", d.glb()),
+                 "material 'material 0': base colour texture: image 0: buffer view runs past the end of its buffer");
+  }
+  {
+    Doc d;  // a data URI that is no image
+    d.base_colour({{"uri", "data:image/png;base64," + base64("not an image at all")}});
+    const std::string path = write("not-image.gltf", d.gltf());
+    expect_error(path, "not-image.gltf#images[0]' (unknown image type)", true);
+  }
+  {
+    Doc d;  // a data URI of a type tinygltf does not decode
+    d.base_colour({{"uri", "data:image/webp;base64," + base64("RIFF")}});
+    expect_error(write("webp.gltf", d.gltf()), "image 0: a data URI of type 'image/webp' is not an image wavetrace reads");
+  }
+  {
+    Doc d;  // KTX2, by its MIME type and by its bytes
+    d.base_colour({{"bufferView", d.view(png)}, {"mimeType", "image/ktx2"}});
+    expect_error(write("ktx2.glb", d.glb()), "KTX2 / Basis Universal textures are not supported");
+    Doc e;
+    const std::string ktx2 = std::string("\xABKTX 20\xBB\r\n\x1A\n", 12) + std::string(64, '\0');
+    e.base_colour({{"bufferView", e.view(ktx2)}, {"mimeType", "image/png"}});
+    expect_error(write("ktx2-bytes.glb", e.glb()), "KTX2 / Basis Universal textures are not supported");
+  }
+}
+
+}  // namespace
+}  // namespace wt
