@@ -396,5 +396,147 @@ TEST_F(GltfAssets, BadEmbeddedImagesAreOneLineErrors) {
   }
 }
 
+
+// ---- KHR_lights_punctual ----
+
+// A 20 m square floor in z = 0 (a white-sky-free scene: black) under one light of
+// `light` (the extension's object) on a node `node` (its translation, rotation),
+// seen from straight above by a narrow camera, the floor Lambertian of albedo 0.5.
+class PunctualLights : public GltfAssets {
+ protected:
+  Scene lit(const json& light, const json& node, const char* sky = "[0, 0, 0]", float vfov = 4.0f) {
+    Doc d;
+    d.j["nodes"][0]["scale"] = {20, 20, 1};
+    d.j["nodes"][0]["translation"] = {-10, -10, 0};
+    json n = node;
+    n["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
+    d.j["nodes"].push_back(n);
+    d.j["scenes"][0]["nodes"] = {0, 1};
+    d.j["extensions"] = {{"KHR_lights_punctual", {{"lights", {light}}}}};
+    d.j["extensionsUsed"] = {"KHR_lights_punctual"};
+    write("lit.gltf", d.gltf());
+    write("scene.json", std::string(R"({"camera": {"look_from": [0, 0, 3], "look_at": [0, 0, 0], "up": [0, 1, 0],
+      "vfov": )") + std::to_string(vfov) + R"(}, "sky": {"type": "uniform", "radiance": )" + sky + R"(},
+      "materials": [{"name": "white", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]}],
+      "meshes": [{"name": "m", "file": "lit.gltf", "material": "white"}], "instances": [{"mesh": "m"}]})");
+    return load_scene((folder_.root() / "scene.json").string());
+  }
+  // The mean of the image's central 2 x 2 pixels' green (all channels alike here).
+  static double centre(const RenderResult& r, int w, int h) {
+    double sum = 0.0;
+    for (int y = h / 2 - 1; y <= h / 2; ++y) {
+      for (int x = w / 2 - 1; x <= w / 2; ++x) sum += r.rgb[3 * (static_cast<size_t>(y) * w + x) + 1];
+    }
+    return sum / (4.0 * (r.radiance == Radiance::SumOfSamples ? r.samples : 1));
+  }
+  static double pixel(const RenderResult& r, int w, int x, int y) {
+    return r.rgb[3 * (static_cast<size_t>(y) * w + x) + 1] / (r.radiance == Radiance::SumOfSamples ? r.samples : 1.0);
+  }
+};
+
+// Radiance of the floor below: albedo / pi times the irradiance, I cos / d^2 for a
+// point (candela as W / sr), E cos for a directional light (lux as W / m^2), with
+// next-event estimation on and off (punctual lights are sampled either way) and on
+// both CPU kernels.
+TEST_F(PunctualLights, GiveTheAnalyticIrradianceOnAPlane) {
+  const double albedo_over_pi = 0.5 / kPi;
+  const int w = 16, h = 16;
+  struct Case {
+    json light, node;
+    double radiance;  // at the centre
+  };
+  const double s30 = 0.5, c30 = std::sqrt(3.0) / 2.0;  // the directional light 60 degrees from the vertical
+  const Case cases[] = {
+      {{{"type", "point"}, {"intensity", 8}, {"color", {1, 1, 1}}}, {{"translation", {0, 0, 2}}}, albedo_over_pi * 8 / 4},
+      {{{"type", "point"}, {"intensity", 8}, {"range", 4}}, {{"translation", {0, 0, 2}}},
+       albedo_over_pi * 8 / 4 * (1 - std::pow(2.0 / 4.0, 4))},
+      {{{"type", "spot"}, {"intensity", 8}, {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.2}}}},
+       {{"translation", {0, 0, 2}}}, albedo_over_pi * 8 / 4},
+      {{{"type", "directional"}, {"intensity", 3}}, {{"rotation", {s30, 0, 0, c30}}}, albedo_over_pi * 3 * 0.5},
+  };
+  for (const Case& c : cases) {
+    const Scene scene = lit(c.light, c.node);
+    ASSERT_EQ(scene.punctual_lights.size(), 1u) << c.light;
+    for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {
+      for (int nee = 0; nee < 2; ++nee) {
+        RenderOptions o = test::options_for(Backend::Cpu, k, w, h, 8, 2, 100, 3);
+        o.params.nee = nee;
+        const RenderResult r = render(scene, o);
+        EXPECT_NEAR(centre(r, w, h), c.radiance, 1e-3 * c.radiance) << c.light << " " << kernel_name(k) << " nee " << nee;
+      }
+    }
+  }
+}
+
+// A spot lights its inner cone fully, nothing past its outer cone, and the ring
+// between by the extension's smooth step: the floor 2 m below, seen 1 m across.
+TEST_F(PunctualLights, ASpotLightsItsConeAndNothingPastIt) {
+  const Scene scene = lit({{"type", "spot"}, {"intensity", 8}, {"spot", {{"innerConeAngle", 0.1}, {"outerConeAngle", 0.2}}}},
+                          {{"translation", {0, 0, 2}}}, "[0, 0, 0]", 2.0f * std::atan(0.5f / 3.0f) * 180.0f / kPi);
+  const int w = 32, h = 32;
+  const RenderResult r = render(scene, test::options_for(Backend::Cpu, Kernel::Megakernel, w, h, 4, 2, 100, 5));
+  // Corners, at 0.7 m from the axis: past the outer cone (2 tan 0.2 = 0.41 m).
+  for (int x : {0, w - 1}) {
+    for (int y : {0, h - 1}) EXPECT_EQ(pixel(r, w, x, y), 0.0) << x << ", " << y;
+  }
+  // At the centre, within the inner cone (0.2 m): I / d^2 at d = 2, times albedo / pi.
+  EXPECT_NEAR(centre(r, w, h), 0.5 / kPi * 8 / 4, 2e-3);
+  // Between the cones (0.3 m out, along x): lit, but less than the centre.
+  const double mid = pixel(r, w, w / 2 + static_cast<int>(0.3 / (1.0 / w)), h / 2);
+  EXPECT_GT(mid, 0.0);
+  EXPECT_LT(mid, 0.9 * centre(r, w, h));
+}
+
+// Every CUDA kernel renders a scene of the three kinds of punctual light as the CPU
+// does (a grey sky and three bounces for noise to compare by).
+TEST_F(PunctualLights, CudaAgreesWithCpu) {
+  WT_REQUIRE_CUDA();
+  Doc d;
+  d.j["nodes"][0]["scale"] = {20, 20, 1};
+  d.j["nodes"][0]["translation"] = {-10, -10, 0};
+  for (int i = 0; i < 3; ++i) {
+    json n = {{"translation", {0.3 * i, 0, 1.5}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}};
+    if (i == 2) n["rotation"] = {0.5, 0, 0, std::sqrt(3.0) / 2.0};
+    d.j["nodes"].push_back(n);
+  }
+  d.j["scenes"][0]["nodes"] = {0, 1, 2, 3};
+  d.j["extensions"] = {{"KHR_lights_punctual",
+                        {{"lights",
+                          {{{"type", "point"}, {"intensity", 4}, {"color", {1, 0.5, 0.25}}},
+                           {{"type", "spot"}, {"intensity", 6}, {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.5}}}},
+                           {{"type", "directional"}, {"intensity", 1.5}}}}}}};
+  write("three.gltf", d.gltf());
+  write("scene.json", R"({"camera": {"look_from": [0, -2, 2], "look_at": [0, 0, 0], "up": [0, 0, 1], "vfov": 60},
+    "sky": {"type": "uniform", "radiance": [0.2, 0.2, 0.2]},
+    "materials": [{"name": "grey", "type": "lambertian", "albedo": [0.6, 0.6, 0.6]}],
+    "meshes": [{"name": "m", "file": "three.gltf", "material": "grey"}], "instances": [{"mesh": "m"}]})");
+  const Scene scene = load_scene((folder_.root() / "scene.json").string());
+  ASSERT_EQ(scene.punctual_lights.size(), 3u);
+  test::expect_cuda_agrees_with_cpu(
+      [&](Backend b, Kernel k, uint32_t seed) { return render(scene, test::options_for(b, k, 48, 32, 8, 4, 100, seed)); },
+      11);
+}
+
+TEST_F(PunctualLights, BadLightsAreOneLineErrors) {
+  const std::pair<json, std::string> cases[] = {
+      {{{"type", "area"}}, "light 0: type 'area' is not point, spot or directional"},
+      {{{"type", "point"}, {"intensity", -1}}, "light 0: intensity must be in [0, 1e9]"},
+      {{{"type", "point"}, {"color", {1, 2, 0}}}, "light 0: color must be 3 numbers in [0, 1]"},
+      {{{"type", "spot"}, {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.4}}}},
+       "light 0: spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi / 2"},
+  };
+  for (const auto& [light, message] : cases) {
+    Doc d;
+    d.j["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    d.j["scenes"][0]["nodes"] = {0, 1};
+    d.j["extensions"] = {{"KHR_lights_punctual", {{"lights", {light}}}}};
+    expect_error(write("bad-light.gltf", d.gltf()), message);
+  }
+  Doc d;
+  d.j["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 3}}}}}});
+  d.j["scenes"][0]["nodes"] = {0, 1};
+  expect_error(write("no-light.gltf", d.gltf()), "node 1: KHR_lights_punctual: light index 3 out of range (0 lights)");
+}
+
 }  // namespace
 }  // namespace wt

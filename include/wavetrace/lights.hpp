@@ -18,6 +18,77 @@ struct LightRef {
 
 // The instance of the LightRef that stands for the sky, when the sky is sampled.
 constexpr int32_t kSkyLight = -1;
+// The instance of a LightRef that stands for a punctual light (its prim: the
+// light's index in the scene's punctual_lights).
+constexpr int32_t kPunctualLight = -2;
+
+enum class PunctualKind : uint32_t { Point = 0, Spot = 1, Directional = 2 };
+
+// A light of no extent, as glTF's KHR_lights_punctual defines them: a point, a spot
+// (a point whose intensity fades from the inner cone to the outer by the
+// extension's smooth step) or a directional light (parallel rays from infinitely
+// far). No path meets one: they are reached by light sampling alone, whether or
+// not the other lights are (path.hpp, sample_light).
+struct PunctualLight {
+  vec3 position;  // point, spot
+  PunctualKind kind;
+  vec3 direction;  // spot, directional: unit, the way the light travels
+  float range;     // point, spot: the distance at which it has faded out (> 0), 0: none
+  // Point, spot: radiant intensity, W / sr in the renderer's units (the extension's
+  // candela); directional: irradiance on a surface facing it (the extension's lux).
+  vec3 intensity;
+  // Spot: the attenuation clamp(cos * scale + offset, 0, 1)^2 of the cosine between
+  // `direction` and the direction to the lit point.
+  float spot_scale, spot_offset;
+
+  // Its power in light_power_of's units (power / pi), which picks it among the
+  // scene's lights: a point's 4 pi I, a spot's outer cone's 2 pi (1 - cos) I (the
+  // smooth edge within it left out), a directional light's E over the scene's
+  // bounding disc of `scene_radius`.
+  WT_HD float power(float scene_radius) const {
+    const float mean = (intensity.x + intensity.y + intensity.z) * (1.0f / 3.0f);
+    switch (kind) {
+      case PunctualKind::Point: return 4.0f * mean;
+      case PunctualKind::Spot: {
+        const float cos_outer = -spot_offset / spot_scale;
+        return 2.0f * (1.0f - cos_outer) * mean;
+      }
+      case PunctualKind::Directional: return mean * scene_radius * scene_radius;
+    }
+    return 0.0f;
+  }
+
+  // The direction (unit) from p toward the light and the distance to it (0 for a
+  // directional light: infinitely far).
+  WT_HD void toward(const vec3& p, vec3& dir, float& dist) const {
+    if (kind == PunctualKind::Directional) {
+      dir = -direction;
+      dist = 0.0f;
+      return;
+    }
+    const vec3 to = position - p;
+    dist = sqrtf(glm::dot(to, to));
+    dir = dist > 0.0f ? to * (1.0f / dist) : vec3(0.0f);
+  }
+
+  // The irradiance it gives, arriving along `dir` (unit, toward the light) from
+  // `dist` away, on a surface facing it: I / d^2 within the cones and the range's
+  // fade (the extension's max(min(1 - (d / range)^4, 1), 0)); E for a directional light.
+  WT_HD vec3 irradiance(const vec3& dir, float dist) const {
+    if (kind == PunctualKind::Directional) return intensity;
+    if (!(dist > 0.0f)) return vec3(0.0f);
+    float falloff = 1.0f / (dist * dist);
+    if (range > 0.0f) {
+      const float r = dist / range, r2 = r * r;
+      falloff *= fmaxf(fminf(1.0f - r2 * r2, 1.0f), 0.0f);
+    }
+    if (kind == PunctualKind::Spot) {
+      const float a = fminf(fmaxf(-glm::dot(direction, dir) * spot_scale + spot_offset, 0.0f), 1.0f);
+      falloff *= a * a;
+    }
+    return intensity * falloff;
+  }
+};
 
 // The power that picks an emitter among the scene's: its emission's mean over the
 // three channels times its area (the factor pi of a diffuse emitter's power is the

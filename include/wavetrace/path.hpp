@@ -89,12 +89,22 @@ constexpr float kShadowShorten = 1e-4f;
 // lobes scatter count what they hit in full. A BSDF that only reflects looks for
 // lights on wo's side of the surface; one that transmits looks on both.
 template <uint32_t Kinds, class Scene>
-WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, const SurfacePoint& sp,
-                                       const vec3& wo, const vec3& throughput, const Rng& rng) {
+WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const RenderParams& rp, const BsdfAt& bsdf,
+                                       const SurfacePoint& sp, const vec3& wo, const vec3& throughput, const Rng& rng) {
   ShadowRay out{};
   out.valid = false;
   float pick;
-  const LightRef light = scene.light(pick_light(scene, rng.uniform(kDimLightPick), pick));
+  LightRef light;
+  if (rp.nee != 0) {
+    light = scene.light(pick_light(scene, rng.uniform(kDimLightPick), pick));
+  } else {
+    // Without next-event estimation the punctual lights alone, which no path meets,
+    // are sampled: one of them, uniformly.
+    const int n = scene.punctual_count();
+    const int i = static_cast<int>(rng.uniform(kDimLightPick) * static_cast<float>(n));
+    light = LightRef{kPunctualLight, i < n ? i : n - 1};
+    pick = 1.0f / static_cast<float>(n);
+  }
   if (!(pick > 0.0f)) return out;
   const float u1 = rng.uniform(WT_MUTANT(DimensionReused) ? kDimLightPick : kDimLightA), u2 = rng.uniform(kDimLightB);
   const vec3 outward = sp.front ? sp.ng : -sp.ng;
@@ -102,7 +112,27 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
   vec3 emitted;
   float drawn_pdf;  // the density the direction was drawn with, times the picking probability
   float light_pdf;  // light_density's (or sky_light_density's) for it, for the MIS weight
-  if (light.instance == kSkyLight) {
+  bool delta = false;  // a punctual light: drawn with probability `pick` alone, met by no path
+  if (light.instance == kPunctualLight) {
+    const PunctualLight pl = scene.punctual_light(light.prim);
+    vec3 dir;
+    float dist;
+    pl.toward(sp.p, dir, dist);
+    if ((pl.kind != PunctualKind::Directional && !(dist > 0.0f)) || (!either_side && glm::dot(dir, outward) <= 0.0f)) {
+      return out;
+    }
+    out.ray = spawn_ray(sp, dir);
+    out.tmax = kRayTMax;
+    if (pl.kind != PunctualKind::Directional) {
+      pl.toward(out.ray.origin, out.ray.dir, dist);
+      if (!(dist > 0.0f)) return out;
+      out.tmax = dist * (1.0f - kShadowShorten);
+    }
+    emitted = pl.irradiance(out.ray.dir, dist);
+    drawn_pdf = pick;
+    light_pdf = 1.0f;
+    delta = true;
+  } else if (light.instance == kSkyLight) {
     const SkyDirection d = sample_sky_direction(scene.sky, scene.environment_table(), u1, u2);
     if (!(d.pdf > 0.0f) || (!either_side && glm::dot(d.dir, outward) <= 0.0f)) return out;
     out.ray = spawn_ray(sp, d.dir);
@@ -134,7 +164,9 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const BsdfAt& bsdf, c
   vec3 f_cos = eval_bsdf<(Kinds & kMicrofacet) != 0>(bsdf, wo, out.ray.dir, bsdf_pdf);
   if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
   if (WT_MUTANT(MissingCosine)) f_cos *= 1.0f / fmaxf(fabsf(glm::dot(out.ray.dir, bsdf.facing_n())), 1e-3f);
-  out.contribution = throughput * f_cos * emitted * (power_heuristic(light_pdf, bsdf_pdf) / drawn_pdf);
+  // A delta light's sample has no rival strategy: its weight is 1.
+  const float weight = delta ? 1.0f : power_heuristic(light_pdf, bsdf_pdf);
+  out.contribution = throughput * f_cos * emitted * (weight / drawn_pdf);
   out.valid = out.contribution.x > 0.0f || out.contribution.y > 0.0f || out.contribution.z > 0.0f;
   return out;
 }
@@ -174,8 +206,10 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.
-  if (nee && bsdf_samples_lights<kFacets>(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
-    shadow = sample_light<Kinds>(scene, bsdf, sp, wo, throughput, rng);
+  // Punctual lights are sampled with next-event estimation off too: nothing else reaches them.
+  const bool punctual = (Kinds & kLightSampling) != 0 && scene.punctual_count() > 0;
+  if ((nee || punctual) && bsdf_samples_lights<kFacets>(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
+    shadow = sample_light<Kinds>(scene, rp, bsdf, sp, wo, throughput, rng);
   }
   const BsdfSample s = sample_bsdf<kFacets>(bsdf, wo, rng);
   if (s.lobe == 0u) return false;

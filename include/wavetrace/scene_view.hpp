@@ -45,7 +45,8 @@ struct RenderParams {
 // hold the microfacet kinds' parameters and bsdf_tables their energy tables
 // (bsdfs/energy.hpp); the lights are every
 // emitter, for next-event estimation, and light_cdf[i] the probability of picking
-// lights 0..i.
+// lights 0..i; punctual_lights are the lights of no extent (lights.hpp), among the
+// lights as kPunctualLight.
 #define WT_SCENE_ARRAYS(X)                                                        \
   X(BvhNode, nodes, node, BvhNode, int)                                           \
   X(Instance, instances, instance, const Instance&, int)                          \
@@ -62,7 +63,8 @@ struct RenderParams {
   X(float, bsdf_tables, bsdf_table, float, int)                                   \
   X(Texture, textures, texture, const Texture&, uint32_t)                         \
   X(LightRef, lights, light, LightRef, int)                                       \
-  X(float, light_cdf, light_cdf_at, float, int)
+  X(float, light_cdf, light_cdf_at, float, int)                                   \
+  X(PunctualLight, punctual_lights, punctual_light, PunctualLight, int)
 
 namespace wt {
 
@@ -70,6 +72,7 @@ namespace wt {
 struct SceneScalars {
   int32_t node_total;
   int32_t light_total;
+  int32_t punctual_total;  // punctual_lights' count
   float light_power;  // the emitters' summed power (light_power_of), which picks them
   // The sky as a light (lights.hpp's kSkyLight): the probability of picking it (0:
   // the sky is not sampled), and the environment's table (rows 0: none).
@@ -81,6 +84,13 @@ struct SceneScalars {
 
   WT_HD int node_count() const { return node_total; }
   WT_HD int light_count() const { return light_total; }
+  WT_HD int punctual_count() const { return punctual_total; }
+  // Whether paths sample lights (the kernels' kLightSampling): where next-event
+  // estimation is on and there are lights, and wherever there are punctual lights,
+  // which nothing else reaches.
+  WT_HD bool samples_lights(const RenderParams& rp) const {
+    return (rp.nee != 0 && light_total > 0) || punctual_total > 0;
+  }
   WT_HD float total_light_power() const { return light_power; }
   WT_HD float sky_light_pick() const { return sky_pick; }
   WT_HD const PiecewiseConstant2D& environment_table() const { return environment; }

@@ -98,7 +98,7 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
                                 unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
-  const uint32_t kinds_and_lights = g_kinds | (rp.nee != 0 && g_scene.light_total > 0 ? kLightSampling : 0u);
+  const uint32_t kinds_and_lights = g_kinds | (g_scene.samples_lights(rp) ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {
     megakernel_constant<decltype(kinds)::value>
         <<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, film, rays);

@@ -15,7 +15,7 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
                        unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp), block(kMegakernelBlockX, kMegakernelBlockY);
   // Light sampling's code is compiled in only where the scene has emitters to sample.
-  const uint32_t kinds_and_lights = scene.kinds | (rp.nee != 0 && scene.light_total > 0 ? kLightSampling : 0u);
+  const uint32_t kinds_and_lights = scene.kinds | (scene.samples_lights(rp) ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {
     megakernel_global<decltype(kinds)::value><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, film, rays);
   });

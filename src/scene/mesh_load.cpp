@@ -568,7 +568,8 @@ std::vector<T> read_accessor(const tinygltf::Model& model, int index, const std:
 // The extensions this reader reads; any other one a file requires is refused, and
 // any other it uses is a warning (what it adds is not rendered).
 const char* const kReadExtensions[] = {"KHR_materials_emissive_strength", "KHR_materials_ior",
-                                       "KHR_materials_specular", "KHR_texture_transform", "KHR_mesh_quantization"};
+                                       "KHR_materials_specular",          "KHR_texture_transform",
+                                       "KHR_mesh_quantization",           "KHR_lights_punctual"};
 
 bool read_extension(const std::string& name) {
   return std::find(std::begin(kReadExtensions), std::end(kReadExtensions), name) != std::end(kReadExtensions);
@@ -937,8 +938,65 @@ class GltfReader {
       const tinygltf::Node& node = model_.nodes[v.node];
       const glm::dmat4 world = v.parent * local_transform(node, mesh_.source);
       if (node.mesh >= 0) read_mesh(node.mesh, world);
+      read_light(node, v.node, world);
       for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
     }
+  }
+
+  // The node's KHR_lights_punctual light, at its origin and shining down its -z.
+  void read_light(const tinygltf::Node& node, int index, const glm::dmat4& world) {
+    auto e = node.extensions.find("KHR_lights_punctual");
+    if (e == node.extensions.end()) return;
+    const std::string& path = mesh_.source;
+    const std::string where = "node " + std::to_string(index) + ": KHR_lights_punctual";
+    if (!e->second.IsObject() || !e->second.Has("light") || !e->second.Get("light").IsInt()) {
+      fail(path, where + ": light must be a light's index");
+    }
+    const int i = e->second.Get("light").GetNumberAsInt();
+    if (i < 0 || static_cast<size_t>(i) >= model_.lights.size()) {
+      fail(path, where + ": light index " + std::to_string(i) + " out of range (" +
+                     std::to_string(model_.lights.size()) + " lights)");
+    }
+    const tinygltf::Light& g = model_.lights[i];
+    const std::string what = "light " + std::to_string(i) + (g.name.empty() ? "" : " '" + g.name + "'");
+    PunctualLight l{};
+    if (g.type == "point") {
+      l.kind = PunctualKind::Point;
+    } else if (g.type == "spot") {
+      l.kind = PunctualKind::Spot;
+    } else if (g.type == "directional") {
+      l.kind = PunctualKind::Directional;
+    } else {
+      fail(path, what + ": type '" + g.type + "' is not point, spot or directional");
+    }
+    vec3 colour(1.0f);
+    if (!g.color.empty()) {
+      for (size_t c = 0; c < 3; ++c) {
+        if (g.color.size() != 3 || !(g.color[c] >= 0.0 && g.color[c] <= 1.0)) {
+          fail(path, what + ": color must be 3 numbers in [0, 1]");
+        }
+        colour[static_cast<int>(c)] = static_cast<float>(g.color[c]);
+      }
+    }
+    if (!(g.intensity >= 0.0 && g.intensity <= kMaxRadiance)) fail(path, what + ": intensity must be in [0, 1e9]");
+    l.intensity = colour * static_cast<float>(g.intensity);
+    if (!(g.range >= 0.0 && std::isfinite(g.range))) fail(path, what + ": range must be a positive number");
+    l.range = l.kind == PunctualKind::Directional ? 0.0f : static_cast<float>(g.range);
+    if (l.kind == PunctualKind::Spot) {
+      const double inner = g.spot.innerConeAngle, outer = g.spot.outerConeAngle;
+      if (!(inner >= 0.0 && inner < outer && outer <= 0.5 * kPi + 1e-6)) {
+        fail(path, what + ": spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi / 2");
+      }
+      // The extension's smooth step between the cones' cosines.
+      const float cos_inner = static_cast<float>(std::cos(inner)), cos_outer = static_cast<float>(std::cos(outer));
+      l.spot_scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
+      l.spot_offset = -cos_outer * l.spot_scale;
+    }
+    l.position = vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+    const glm::dvec3 d = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+    if (!(glm::length(d) > 0.0)) fail(path, where + ": the node's transform collapses the light's direction");
+    l.direction = vec3(glm::normalize(d));
+    mesh_.lights.push_back(l);
   }
 
   void read_mesh(int index, const glm::dmat4& world) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/lights.hpp"
 #include "wavetrace/material.hpp"
 #include "wavetrace/texture.hpp"
 
@@ -70,6 +71,9 @@ struct TriangleMesh {
   // What the file holds that is not rendered (an extension it uses that wavetrace
   // does not read), one line each; the scene counts and prints them.
   std::vector<std::string> warnings;
+  // Its punctual lights (glTF's KHR_lights_punctual), in the file's space (its
+  // nodes' transforms applied).
+  std::vector<PunctualLight> lights;
   size_t dropped_degenerate = 0;  // zero-area triangles (and faces of fewer than 3 corners)
   size_t dropped_nan = 0;         // triangles with a non-finite position
 };

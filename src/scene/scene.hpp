@@ -54,6 +54,7 @@ struct SceneMesh {
   size_t dropped_degenerate = 0;  // triangles the loader dropped (mesh_load.hpp)
   size_t dropped_nan = 0;
   std::vector<std::string> warnings;  // what the file holds that is not rendered (mesh_load.hpp)
+  std::vector<PunctualLight> lights;  // the file's punctual lights, in its space: each instance places them
   BvhStats bvh;
 };
 

@@ -248,6 +248,23 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
           EmitterShape::of_triangle(a, b, c));
     }
   }
+  // Each placed mesh's punctual lights, in world space.
+  scene.punctual_lights.clear();
+  const float radius = scene.nodes.empty() ? 0.0f : 0.5f * glm::length(node_bounds(scene.nodes[0]).hi - node_bounds(scene.nodes[0]).lo);
+  for (size_t i = 0; i < scene.instances.size(); ++i) {
+    const Instance& in = scene.instances[i];
+    if (in.kind == PrimitiveKind::Sphere) continue;
+    for (PunctualLight l : scene.meshes.at(static_cast<size_t>(instance_mesh.at(i))).lights) {
+      l.position = in.world_from_object.point(l.position);
+      const vec3 d = in.world_from_object.vector(l.direction);
+      l.direction = glm::length(d) > 0.0f ? glm::normalize(d) : l.direction;
+      const float p = l.power(radius);
+      if (!(p > 0.0f)) continue;
+      scene.lights.push_back(LightRef{kPunctualLight, static_cast<int32_t>(scene.punctual_lights.size())});
+      scene.punctual_lights.push_back(l);
+      power.push_back(p);
+    }
+  }
   const float sky = sky_light_power(scene);
   if (sky > 0.0f) {
     scene.lights.push_back(LightRef{kSkyLight, 0});

@@ -178,6 +178,7 @@ SceneScalars scene_scalars(const Scene& scene, int width, int height, const Piec
   SceneScalars v{};
   v.node_total = static_cast<int32_t>(scene.nodes.size());
   v.light_total = static_cast<int32_t>(scene.lights.size());
+  v.punctual_total = static_cast<int32_t>(scene.punctual_lights.size());
   v.light_power = scene.light_power;
   v.sky_pick = scene.sky_pick;
   v.environment = environment;

@@ -89,7 +89,7 @@ template <class Exec>
 RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, const RenderOptions& options,
                               int64_t capacity) {
   const RenderParams& rp = options.params;
-  const bool light_sampling = rp.nee != 0 && scene.light_total > 0;
+  const bool light_sampling = scene.samples_lights(rp);
   const uint32_t shade_kinds = scene.kinds | (light_sampling ? kLightSampling : 0u);
   const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
   // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
