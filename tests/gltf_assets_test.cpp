@@ -397,6 +397,59 @@ TEST_F(GltfAssets, BadEmbeddedImagesAreOneLineErrors) {
 }
 
 
+
+// ---- Cameras ----
+
+// "camera": {"gltf": MESH, "index": N} is the file's camera N where its node puts
+// it, looking down the node's -z, placed by the mesh's first instance; its yfov is
+// the vertical field of view.
+TEST_F(GltfAssets, ACameraOfTheFileIsChosenByMeshAndIndex) {
+  Doc d;
+  d.j["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.1}}}},
+                    {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}},
+                    {{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}};
+  // Camera 0 three metres above the quad's centre (looking down -z at it); camera 1
+  // on a node too; camera 2 on none.
+  d.j["nodes"].push_back({{"camera", 0}, {"translation", {0.5, 0.5, 3}}});
+  d.j["nodes"].push_back({{"camera", 1}});
+  d.j["scenes"][0]["nodes"] = {0, 1, 2};
+  write("cameras.gltf", d.gltf());
+  auto scene_with = [&](const std::string& camera) {
+    write("scene.json", R"({"camera": )" + camera + R"(, "materials": [], "sky": {"type": "uniform", "radiance": [1, 1, 1]},
+      "meshes": [{"name": "m", "file": "cameras.gltf"}], "instances": [{"mesh": "m", "translate": [1, 0, 0]}]})");
+    return (folder_.root() / "scene.json").string();
+  };
+  const Scene scene = load_scene(scene_with(R"({"gltf": "m", "index": 0})"));
+  EXPECT_EQ(scene.camera.look_from, vec3(1.5f, 0.5f, 3.0f));
+  EXPECT_EQ(scene.camera.look_at, vec3(1.5f, 0.5f, 2.0f));
+  EXPECT_EQ(scene.camera.up, vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_FLOAT_EQ(scene.camera.vfov_degrees, static_cast<float>(0.5 * 180.0 / kPi));
+  // Seen from it, the (white-sky-lit) quad fills the image's centre.
+  const RenderResult r = render(scene, test::options_for(Backend::Cpu, Kernel::Megakernel, 8, 8, 4, 2, 100, 1));
+  // (The sky seen directly is 1 in every channel; the quad, a grey dielectric-
+  // coated surface, less.)
+  EXPECT_GT(r.rgb[3 * (4 * 8 + 4)], 0.0f);
+  EXPECT_LT(r.rgb[3 * (4 * 8 + 4)], 0.95f * r.samples);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"({"gltf": "m", "index": 3})", "/camera/index: camera 3 of mesh 'm' is out of range (its file has 3 cameras)"},
+      {R"({"gltf": "m", "index": 1})", "/camera/index: camera 1 of mesh 'm' is orthographic"},
+      {R"({"gltf": "m", "index": 2})", "/camera/index: camera 2 of mesh 'm' is on no node of the file's scene"},
+      {R"({"gltf": "n"})", "/camera/gltf: unknown mesh 'n'"},
+      {R"({"gltf": "m", "look_from": [0, 0, 0]})", "/camera"},
+      {R"({"gltf": "m", "aperture": 0.1})", "/camera/aperture: needs focus_distance"},
+  };
+  for (const auto& [camera, message] : bad) {
+    const std::string path = scene_with(camera);
+    try {
+      load_scene(path);
+      ADD_FAILURE() << camera << " loaded";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(path + ": " + message), std::string::npos) << e.what();
+    }
+  }
+}
+
 // ---- KHR_lights_punctual ----
 
 // A 20 m square floor in z = 0 (a white-sky-free scene: black) under one light of

@@ -854,6 +854,22 @@ class GltfReader {
   GltfReader(const tinygltf::Model& model, const fs::path& dir, TriangleMesh& mesh)
       : model_(model), mesh_(mesh), builder_(mesh), images_{model, dir, mesh, {}} {
     check_extensions(model, mesh);
+    for (size_t i = 0; i < model.cameras.size(); ++i) {
+      const tinygltf::Camera& g = model.cameras[i];
+      MeshCamera c;
+      c.name = g.name;
+      c.perspective = g.type != "orthographic";
+      if (c.perspective) {
+        if (g.type != "perspective") {
+          fail(mesh.source, "camera " + std::to_string(i) + ": type '" + g.type + "' is not perspective or orthographic");
+        }
+        if (!(g.perspective.yfov > 0.0 && g.perspective.yfov < kPi)) {
+          fail(mesh.source, "camera " + std::to_string(i) + ": yfov must be in (0, pi) radians");
+        }
+        c.yfov = static_cast<float>(g.perspective.yfov);
+      }
+      mesh.cameras.push_back(c);
+    }
     for (size_t i = 0; i < model.materials.size(); ++i) {
       mesh.materials.push_back(map_gltf(images_, model.materials[i], i));
     }
@@ -939,8 +955,29 @@ class GltfReader {
       const glm::dmat4 world = v.parent * local_transform(node, mesh_.source);
       if (node.mesh >= 0) read_mesh(node.mesh, world);
       read_light(node, v.node, world);
+      if (node.camera >= 0) place_camera(node, v.node, world);
       for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
     }
+  }
+
+  // The node's camera at the node's origin, looking down its -z, +y up (the first
+  // node that names a camera places it).
+  void place_camera(const tinygltf::Node& node, int index, const glm::dmat4& world) {
+    if (static_cast<size_t>(node.camera) >= mesh_.cameras.size()) {
+      fail(mesh_.source, "node " + std::to_string(index) + ": camera index " + std::to_string(node.camera) +
+                             " out of range (" + std::to_string(mesh_.cameras.size()) + " cameras)");
+    }
+    MeshCamera& c = mesh_.cameras[node.camera];
+    if (c.placed) return;
+    const glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+    const glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
+    if (!(glm::length(glm::cross(forward, up)) > 0.0)) {
+      fail(mesh_.source, "node " + std::to_string(index) + ": the node's transform collapses its camera's view");
+    }
+    c.position = vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+    c.forward = vec3(glm::normalize(forward));
+    c.up = vec3(glm::normalize(up));
+    c.placed = true;
   }
 
   // The node's KHR_lights_punctual light, at its origin and shining down its -z.

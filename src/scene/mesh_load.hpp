@@ -56,6 +56,16 @@ struct EmbeddedImage {
   std::string bytes;
 };
 
+// A camera of the file (glTF's cameras), where the first node that names it places
+// it: looking down the node's -z with +y up, in the file's space.
+struct MeshCamera {
+  std::string name;
+  bool perspective = true;  // false: orthographic (which wavetrace does not render)
+  vec3 position{0.0f}, forward{0.0f, 0.0f, -1.0f}, up{0.0f, 1.0f, 0.0f};
+  float yfov = 0.0f;  // radians
+  bool placed = false;  // a node names it
+};
+
 struct TriangleMesh {
   std::string source;  // the mesh file
   std::vector<vec3> positions;
@@ -74,6 +84,7 @@ struct TriangleMesh {
   // Its punctual lights (glTF's KHR_lights_punctual), in the file's space (its
   // nodes' transforms applied).
   std::vector<PunctualLight> lights;
+  std::vector<MeshCamera> cameras;  // by the file's camera index
   size_t dropped_degenerate = 0;  // zero-area triangles (and faces of fewer than 3 corners)
   size_t dropped_nan = 0;         // triangles with a non-finite position
 };

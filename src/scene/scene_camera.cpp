@@ -8,8 +8,22 @@
 namespace wt {
 
 void SceneReader::read_camera(const json& j, const JsonPath& path) {
-  check_keys(j, path, {"look_from", "look_at", "up", "vfov", "aperture", "focus_distance"});
   CameraSpec& c = scene_.camera;
+  object(j, path);
+  if (j.contains("gltf")) {
+    // A mesh file's camera: placed when the meshes are read (place_mesh_camera).
+    check_keys(j, path, {"gltf", "index", "aperture", "focus_distance"});
+    mesh_camera_.chosen = true;
+    mesh_camera_.mesh = string(j["gltf"], path / "gltf");
+    mesh_camera_.index = j.contains("index") ? static_cast<size_t>(integer(j["index"], path / "index", 0, 1 << 30)) : 0;
+    if (j.contains("aperture")) c.aperture = non_negative(j["aperture"], path / "aperture");
+    if (j.contains("focus_distance")) c.focus_distance = positive(j["focus_distance"], path / "focus_distance");
+    if (c.aperture > 0.0f && !j.contains("focus_distance")) {
+      fail_at(path / "aperture", "needs focus_distance with a mesh file's camera (it has no look_at)");
+    }
+    return;
+  }
+  check_keys(j, path, {"look_from", "look_at", "up", "vfov", "aperture", "focus_distance"});
   c.look_from = position(required(j, path, "look_from"), path / "look_from");
   c.look_at = position(required(j, path, "look_at"), path / "look_at");
   if (j.contains("up")) c.up = triple(j["up"], path / "up");
@@ -32,6 +46,38 @@ void SceneReader::read_camera(const json& j, const JsonPath& path) {
     fail_at(path / "up", std::string("must not be parallel to the view direction look_at - look_from") +
                                    (j.contains("up") ? "" : " (up defaults to [0, 1, 0])"));
   }
+}
+
+void SceneReader::place_mesh_camera() {
+  if (!mesh_camera_.chosen) return;
+  const JsonPath root;  // (a path points at its parent: the root must outlive it)
+  const JsonPath path = root / "camera";
+  auto found = mesh_names_.find(mesh_camera_.mesh);
+  if (found == mesh_names_.end()) fail_at(path / "gltf", "unknown mesh '" + mesh_camera_.mesh + "'");
+  const size_t mesh = found->second.first;
+  const std::vector<MeshCamera>& cameras = mesh_cameras_.at(mesh);
+  const std::string which = "camera " + std::to_string(mesh_camera_.index) + " of mesh '" + mesh_camera_.mesh + "'";
+  if (mesh_camera_.index >= cameras.size()) {
+    fail_at(path / "index", which + " is out of range (its file has " + std::to_string(cameras.size()) + " cameras)");
+  }
+  const MeshCamera& mc = cameras[mesh_camera_.index];
+  if (!mc.perspective) fail_at(path / "index", which + " is orthographic; wavetrace renders perspective cameras");
+  if (!mc.placed) fail_at(path / "index", which + " is on no node of the file's scene");
+  // Placed by the mesh's first instance, as its lights are by each.
+  Affine world = kIdentityTransform;
+  for (const Placement& p : scene_.placements) {
+    if (p.mesh == static_cast<int32_t>(mesh)) {
+      world = p.world_from_object;
+      break;
+    }
+  }
+  CameraSpec& c = scene_.camera;
+  c.look_from = world.point(mc.position);
+  const vec3 forward = world.vector(mc.forward), up = world.vector(mc.up);
+  const float focus = c.focus_distance > 0.0f ? c.focus_distance : 1.0f;
+  c.look_at = c.look_from + focus * glm::normalize(forward);
+  c.up = glm::normalize(up);
+  c.vfov_degrees = mc.yfov * (180.0f / kPi);
 }
 
 void SceneReader::read_sky(const json& j, const JsonPath& path) {

@@ -44,6 +44,7 @@ void SceneReader::read(const json& root) {
   if (scene_.placements.empty()) {
     fail_at(top / "spheres", "the scene has nothing to render: it needs at least one sphere or one instance");
   }
+  place_mesh_camera();
   const auto start = Clock::now();
   build_texture_mips(scene_);
   texture_seconds_ += seconds_since(start);

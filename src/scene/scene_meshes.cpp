@@ -132,6 +132,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   sm.dropped_nan = mesh.dropped_nan;
   sm.warnings = mesh.warnings;
   sm.lights = mesh.lights;
+  mesh_cameras_.push_back(mesh.cameras);
   // Normals and UVs are stored per vertex where the mesh has them; a triangle's
   // indices point into whichever the mesh has (both arrays grow alike).
   const bool normals = !mesh.normals.empty(), uvs = !mesh.uvs.empty();

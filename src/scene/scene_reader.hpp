@@ -53,6 +53,9 @@ class SceneReader : JsonReader {
 
   // scene_camera.cpp
   void read_camera(const json& j, const JsonPath& path);
+  // A camera that a mesh file holds (`"camera": {"gltf": MESH, "index": N}`), placed
+  // once the meshes and instances are read.
+  void place_mesh_camera();
   void read_sky(const json& j, const JsonPath& path);
   void read_render(const json& j, const JsonPath& path);
 
@@ -97,6 +100,12 @@ class SceneReader : JsonReader {
   // are in bsdf_tables.
   SharedTables shared_tables_;
   Names mesh_names_;
+  std::vector<std::vector<MeshCamera>> mesh_cameras_;  // each mesh file's, by mesh index
+  struct MeshCameraChoice {
+    std::string mesh;
+    size_t index = 0;
+    bool chosen = false;
+  } mesh_camera_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
   double texture_seconds_ = 0;
   double mesh_seconds_ = 0;
