@@ -306,7 +306,8 @@ int main(int argc, char** argv) {
         corner[k][0] = p.x, corner[k][1] = p.y, corner[k][2] = p.z;
         prims[i].box.grow(p);
       }
-      tris[i].pad0 = tris[i].pad1 = tris[i].pad2 = 0.0f;
+      tris[i].alpha = 0;
+      tris[i].pad1 = tris[i].pad2 = 0.0f;
       prims[i].centroid = prims[i].box.centre();  // as scene_bvh.cpp's triangle_primitive
       box.grow(prims[i].box);
     }

@@ -18,6 +18,7 @@
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
 #include "test_support.hpp"
+#include "wavetrace/path.hpp"
 #include "wavetrace/texture.hpp"
 
 // tinygltf's own encoder (compiled in src/scene/mesh_libraries.cpp), for data URIs.
@@ -448,6 +449,166 @@ TEST_F(GltfAssets, ACameraOfTheFileIsChosenByMeshAndIndex) {
       EXPECT_NE(std::string(e.what()).find(path + ": " + message), std::string::npos) << e.what();
     }
   }
+}
+
+
+// ---- Alpha ----
+
+// A 4 x 4 RGBA PNG, white, opaque where (x + y) is even and clear elsewhere.
+std::string checker_alpha_png() {
+  std::vector<unsigned char> px(4 * 4 * 4, 255);
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 4; ++x) px[4 * (4 * y + x) + 3] = (x + y) % 2 == 0 ? 255 : 0;
+  }
+  std::string out;
+  auto append = [](void* ctx, void* data, int size) {
+    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
+  };
+  EXPECT_NE(stbi_write_png_to_func(append, &out, 4, 4, 4, px.data(), 16), 0);
+  return out;
+}
+
+// alphaMode MASK cuts the quad out texel by texel: a ray down onto it (a camera's or
+// a bounce's) and a shadow ray up through it pass where the texel is clear and stop
+// where it is opaque, alike.
+TEST_F(GltfAssets, AlphaMaskLetsEveryRayThroughCutOutTexelsAlike) {
+  write("holes.png", checker_alpha_png());
+  Doc d;
+  d.base_colour({{"uri", "holes.png"}}, json::object(), {{"magFilter", 9728}, {"minFilter", 9728}});
+  d.j["materials"][0]["alphaMode"] = "MASK";
+  d.j["materials"][0]["doubleSided"] = true;
+  const Scene scene = scene_of(write("mask.gltf", d.gltf()));
+  ASSERT_EQ(scene.alpha_tests.size(), 1u);
+  EXPECT_EQ(scene.alpha_tests[0].mode, AlphaMode::Mask);
+  EXPECT_FLOAT_EQ(scene.alpha_tests[0].cutoff, 0.5f);
+  std::vector<ImageView> views;
+  const SceneView view = host_view(scene, 8, 8, views);
+  for (int ty = 0; ty < 4; ++ty) {
+    for (int tx = 0; tx < 4; ++tx) {
+      // Texel (tx, ty)'s centre: u = x, v = 1 - y on the quad.
+      const float x = (tx + 0.5f) / 4, y = 1.0f - (ty + 0.5f) / 4;
+      const bool opaque = (tx + ty) % 2 == 0;
+      const Hit down = intersect_scene(view, Ray{vec3(x, y, 2.0f), vec3(0, 0, -1)});
+      EXPECT_EQ(!down.missed(), opaque) << tx << ", " << ty;
+      EXPECT_EQ(occluded(view, Ray{vec3(x, y, -1.0f), vec3(0, 0, 1)}, 3.0f), opaque) << tx << ", " << ty;
+    }
+  }
+  // An alpha at the cutoff is there (alpha >= cutoff), and a higher cutoff clears more.
+  Doc opaque;
+  opaque.j["materials"][0]["alphaMode"] = "MASK";
+  opaque.j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 0.5};
+  EXPECT_TRUE(scene_of(write("at-cutoff.gltf", opaque.gltf())).alpha_tests.empty());  // wholly there: no test
+  opaque.j["materials"][0]["alphaCutoff"] = 0.6;
+  const Scene gone = scene_of(write("below-cutoff.gltf", opaque.gltf()));
+  ASSERT_EQ(gone.alpha_tests.size(), 1u);
+  std::vector<ImageView> gone_views;
+  EXPECT_TRUE(intersect_scene(host_view(gone, 8, 8, gone_views), Ray{vec3(0.5f, 0.5f, 2.0f), vec3(0, 0, -1)}).missed());
+}
+
+// alphaMode BLEND lets a ray through with the chance of its transparency: over many
+// rays the share that meet the quad is its alpha (within 4 standard errors); an
+// instance that puts its own material in place of the file's makes it opaque.
+TEST_F(GltfAssets, AlphaBlendStopsRaysByItsAlphaOnAverage) {
+  Doc d;
+  d.j["materials"][0]["alphaMode"] = "BLEND";
+  d.j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 0.3};
+  const Scene scene = scene_of(write("blend.gltf", d.gltf()));
+  ASSERT_EQ(scene.alpha_tests.size(), 1u);
+  std::vector<ImageView> views;
+  const SceneView view = host_view(scene, 8, 8, views);
+  const int n = 20000;
+  int hits = 0;
+  Rng rng = Rng::at(1, 2, 3, 0);
+  for (int i = 0; i < n; ++i) {
+    const Ray ray{vec3(0.05f + 0.9f * rng.uniform(0), 0.05f + 0.9f * rng.uniform(1), 2.0f), vec3(0, 0, -1)};
+    rng = Rng::at(1, 2, 3, static_cast<uint32_t>(i + 1));
+    hits += intersect_scene(view, ray).missed() ? 0 : 1;
+  }
+  EXPECT_NEAR(hits / double(n), 0.3, 4.0 * std::sqrt(0.3 * 0.7 / n));
+
+  write("scene.json", R"({"camera": {"look_from": [0.5, 0.5, 2], "look_at": [0.5, 0.5, 0]}, "materials": [
+    {"name": "grey", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]}],
+    "meshes": [{"name": "m", "file": "blend.gltf"}], "instances": [{"mesh": "m", "material": "grey"}]})");
+  const Scene over = load_scene((folder_.root() / "scene.json").string());
+  std::vector<ImageView> over_views;
+  const SceneView ov = host_view(over, 8, 8, over_views);
+  for (int i = 0; i < 100; ++i) {
+    EXPECT_FALSE(intersect_scene(ov, Ray{vec3(0.01f * i + 0.005f, 0.5f, 2.0f), vec3(0, 0, -1)}).missed()) << i;
+  }
+}
+
+// A lamp quad whose left half is cut away by MASK lights the floor below on its right
+// half only, seen by paths that meet it and by light sampling alike: the floor's
+// halves converge to the same means with next-event estimation on and off.
+class AlphaLamp : public GltfAssets {
+ protected:
+  Scene lamp_scene() {
+    const unsigned char px[] = {255, 255, 255, 0, 255, 255, 255, 255};  // clear | opaque
+    std::string png;
+    auto append = [](void* ctx, void* data, int size) {
+      static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
+    };
+    EXPECT_NE(stbi_write_png_to_func(append, &png, 2, 1, 4, px, 8), 0);
+    write("half.png", png);
+    Doc d;
+    d.base_colour({{"uri", "half.png"}}, json::object(), {{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}});
+    d.j["materials"][0]["alphaMode"] = "MASK";
+    d.j["materials"][0]["emissiveFactor"] = {1, 1, 1};
+    d.j["materials"][0]["extensions"] = {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}};
+    write("lamp.gltf", d.gltf());
+    write("floor.obj", "v -1 -1 0\nv 2 -1 0\nv 2 2 0\nv -1 2 0\nf 1 2 3\nf 1 3 4\n");
+    write("scene.json", R"({"camera": {"look_from": [0.5, 0.5, 3], "look_at": [0.5, 0.5, 0], "vfov": 60},
+      "sky": {"type": "uniform", "radiance": [0, 0, 0]},
+      "materials": [{"name": "floor", "type": "lambertian", "albedo": [0.8, 0.8, 0.8]}],
+      "meshes": [{"name": "floor", "file": "floor.obj", "material": "floor"}, {"name": "lamp", "file": "lamp.gltf"}],
+      "instances": [{"mesh": "floor"}, {"mesh": "lamp", "translate": [0, 0, 0.8]}]})");
+    return load_scene((folder_.root() / "scene.json").string());
+  }
+};
+
+TEST_F(AlphaLamp, LightSamplingSeesTheCutOutAsPathsDo) {
+  const Scene scene = lamp_scene();
+  ASSERT_EQ(scene.alpha_tests.size(), 1u);
+  const int w = 32, h = 32;
+  // The floor's strips under the lamp's two halves, x in [0.1, 0.4] and [0.6, 0.9]
+  // (the camera looks straight down from 3 m: the image spans 3.46 m).
+  auto strip = [&](const RenderResult& r, float x0, float x1) {
+    double sum = 0.0;
+    int count = 0;
+    for (int py = 0; py < h; ++py) {
+      for (int px = 0; px < w; ++px) {
+        const float x = 0.5f + ((px + 0.5f) / w - 0.5f) * 3.4641f, y = 0.5f - ((py + 0.5f) / h - 0.5f) * 3.4641f;
+        if (x < x0 || x > x1 || y < 0.1f || y > 0.9f) continue;
+        sum += r.rgb[3 * (static_cast<size_t>(py) * w + px) + 1];
+        ++count;
+      }
+    }
+    return sum / (count * (r.radiance == Radiance::SumOfSamples ? r.samples : 1));
+  };
+  std::vector<double> left[2], right[2];
+  for (int nee = 0; nee < 2; ++nee) {
+    for (uint32_t seed = 1; seed <= 16; ++seed) {
+      RenderOptions o = test::options_for(Backend::Cpu, Kernel::Megakernel, w, h, 256, 3, 100, seed);
+      o.params.nee = nee;
+      const RenderResult r = render(scene, o);
+      left[nee].push_back(strip(r, 0.1f, 0.4f));
+      right[nee].push_back(strip(r, 0.6f, 0.9f));
+    }
+  }
+  // The floor sees the lamp's right half from under both strips, but the lamp itself
+  // is seen only where opaque: from above, the left strip is the floor lit from the
+  // side, the right strip is the lamp's back (it emits on both faces).
+  test::expect_same_expectation(left[1], left[0], 0.05);
+  test::expect_same_expectation(right[1], right[0], 0.05);
+  EXPECT_GT(test::mean_and_standard_error(right[1]).mean, 2.0 * test::mean_and_standard_error(left[1]).mean);
+}
+
+TEST_F(AlphaLamp, CudaAgreesWithCpu) {
+  WT_REQUIRE_CUDA();
+  const Scene scene = lamp_scene();
+  test::expect_cuda_agrees_with_cpu(
+      [&](Backend b, Kernel k, uint32_t seed) { return render(scene, test::options_for(b, k, 32, 32, 8, 4, 100, seed)); },
+      21);
 }
 
 // ---- KHR_lights_punctual ----

@@ -146,6 +146,11 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const RenderParams& r
     const Hit at{s.dist, light.instance, light.prim, s.b1, s.b2};
     const Material& lm = scene.material(material_index<Kinds>(scene, at));
     emitted = emitted_radiance<Kinds>(scene, lm, Ray{sp.p, s.dir}, at);
+    // An alpha-tested emitter gives light where it is there (on average, as a path
+    // meets it).
+    if (!spheres_only(Kinds) && scene.instance(light.instance).kind == PrimitiveKind::Triangle) {
+      emitted *= alpha_coverage(scene, scene.triangle(light.prim).alpha, light.instance, light.prim, s.b1, s.b2);
+    }
     // The shadow ray leaves from the offset a ray leaving the surface starts at, and
     // is aimed at the sampled point itself, so that it ends on the light's surface
     // (shortened by kShadowShorten) however large the offset is.

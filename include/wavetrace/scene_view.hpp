@@ -46,7 +46,8 @@ struct RenderParams {
 // (bsdfs/energy.hpp); the lights are every
 // emitter, for next-event estimation, and light_cdf[i] the probability of picking
 // lights 0..i; punctual_lights are the lights of no extent (lights.hpp), among the
-// lights as kPunctualLight.
+// lights as kPunctualLight; alpha_tests are the alpha-tested materials' (a
+// triangle's `alpha` names its own).
 #define WT_SCENE_ARRAYS(X)                                                        \
   X(BvhNode, nodes, node, BvhNode, int)                                           \
   X(Instance, instances, instance, const Instance&, int)                          \
@@ -64,7 +65,8 @@ struct RenderParams {
   X(Texture, textures, texture, const Texture&, uint32_t)                         \
   X(LightRef, lights, light, LightRef, int)                                       \
   X(float, light_cdf, light_cdf_at, float, int)                                   \
-  X(PunctualLight, punctual_lights, punctual_light, PunctualLight, int)
+  X(PunctualLight, punctual_lights, punctual_light, PunctualLight, int)           \
+  X(AlphaTest, alpha_tests, alpha_test, AlphaTest, int)
 
 namespace wt {
 

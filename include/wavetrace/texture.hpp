@@ -166,10 +166,16 @@ WT_HD WT_INLINE vec3 bilinear(int w, int h, float u, float v, Wrap wrap_u, Wrap 
   return (1.0f - ay) * top + ay * bottom;
 }
 
+// The texel of the full image nearest to (u, v), wrapped by the modes.
+WT_HD WT_INLINE void nearest_texel(const ImageView& im, float u, float v, Wrap wrap_u, Wrap wrap_v, int& x, int& y) {
+  x = wrap_index(static_cast<int>(floorf(wrap_coordinate(u, wrap_u) * im.width)), im.width, wrap_u);
+  y = wrap_index(static_cast<int>(floorf(wrap_coordinate(v, wrap_v) * im.height)), im.height, wrap_v);
+}
+
 // The nearest texel of the full image.
 WT_HD WT_INLINE vec3 sample_image_nearest(const ImageView& im, float u, float v, Wrap wrap_u, Wrap wrap_v) {
-  const int x = wrap_index(static_cast<int>(floorf(wrap_coordinate(u, wrap_u) * im.width)), im.width, wrap_u);
-  const int y = wrap_index(static_cast<int>(floorf(wrap_coordinate(v, wrap_v) * im.height)), im.height, wrap_v);
+  int x, y;
+  nearest_texel(im, u, v, wrap_u, wrap_v, x, y);
   return image_texel(im, x, y);
 }
 
@@ -273,6 +279,14 @@ WT_HD WT_INLINE float turbulence(vec3 p, int octaves) {
   return sum;
 }
 
+// An image texture's coordinates from the surface's: scaled, rotated and offset
+// (the UV transform), before they are wrapped.
+WT_HD WT_INLINE vec2 texture_uv(const Texture& t, vec2 uv) {
+  if (WT_MUTANT(TextureVFlipped)) uv.y = 1.0f - uv.y;
+  const vec2 s = uv * t.uv_scale;
+  return t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
+}
+
 // Procedural textures are functions of the object-space point (a sphere's: relative
 // to its centre); images are looked up by the surface's UVs (a sphere's from its normal).
 // Filtered = false: compiled for kernels without the mip-mapped lookup (the study's
@@ -291,10 +305,7 @@ WT_HD WT_INLINE vec3 eval_texture(const Texture& t, const ImageView* images, con
       return t.b + s * (t.a - t.b);
     }
     case TextureKind::Image: {
-      vec2 uv = sp.has_uv ? sp.uv : sphere_uv(sp.n);
-      if (WT_MUTANT(TextureVFlipped)) uv.y = 1.0f - uv.y;
-      const vec2 s = uv * t.uv_scale;
-      uv = t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
+      const vec2 uv = texture_uv(t, sp.has_uv ? sp.uv : sphere_uv(sp.n));
       const ImageView& im = images[t.image];
       if constexpr (Filtered) {
         // The level of detail only where minifying and magnifying differ.

@@ -783,9 +783,30 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
     out.uv_set = first_set;
     return t;
   };
+  // Alpha: the base colour's, where the mode reads it.
+  if (g.alphaMode == "MASK" || g.alphaMode == "BLEND") {
+    out.alpha_factor = static_cast<float>(pbr.baseColorFactor[3]);
+    if (!(out.alpha_factor >= 0.0f && out.alpha_factor <= 1.0f)) {
+      fail(path, what + ": baseColorFactor's alpha must be in [0, 1]");
+    }
+    if (g.alphaMode == "MASK") {
+      if (!(g.alphaCutoff >= 0.0 && g.alphaCutoff <= 1e9)) fail(path, what + ": alphaCutoff must be a number >= 0");
+      out.alpha_cutoff = static_cast<float>(g.alphaCutoff);
+    }
+    // Without a texture a constant alpha decides once: wholly there, or (MASK)
+    // wholly not; BLEND keeps its chance.
+    const bool textured = pbr.baseColorTexture.index >= 0;
+    const bool opaque = !textured && (g.alphaMode == "MASK" ? out.alpha_factor >= out.alpha_cutoff : out.alpha_factor >= 1.0f);
+    if (!opaque) out.alpha_mode = static_cast<uint32_t>(g.alphaMode == "MASK" ? AlphaMode::Mask : AlphaMode::Blend);
+  } else if (g.alphaMode != "OPAQUE") {
+    fail(path, what + ": alphaMode '" + g.alphaMode + "' is not OPAQUE, MASK or BLEND");
+  }
   if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > 0.0f) {
     out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, emissive);
     if (g.emissiveTexture.index >= 0) out.albedo_map = texture(g.emissiveTexture, "emissive texture");
+    if (out.alpha_mode != 0 && pbr.baseColorTexture.index >= 0) {
+      out.alpha_map = texture(pbr.baseColorTexture, "base colour texture");
+    }
     return out;
   }
   out.material = make_material(MaterialKind::Principled, base, 0.0f, 1.0f, vec3(0.0f));
@@ -806,6 +827,7 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   }
   out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
   if (pbr.baseColorTexture.index >= 0) out.albedo_map = texture(pbr.baseColorTexture, "base colour texture");
+  if (out.alpha_mode != 0) out.alpha_map = out.albedo_map;
   if (pbr.metallicRoughnessTexture.index >= 0) {
     out.metallic_roughness_map = texture(pbr.metallicRoughnessTexture, "metallic-roughness texture");
   }
@@ -819,9 +841,6 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   // Occlusion is read and checked, not applied: the paths find the occlusion.
   if (g.occlusionTexture.index >= 0 && static_cast<size_t>(g.occlusionTexture.index) >= images.model.textures.size()) {
     fail(path, what + ": occlusion texture index out of range");
-  }
-  if (g.alphaMode != "OPAQUE" && !g.alphaMode.empty()) {
-    images.mesh.warnings.push_back(what + ": alphaMode " + g.alphaMode + " is not read yet; the surface is opaque");
   }
   return out;
 }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "wavetrace/geometry/alpha.hpp"
 #include "wavetrace/lights.hpp"
 #include "wavetrace/material.hpp"
 #include "wavetrace/texture.hpp"
@@ -44,6 +45,12 @@ struct MeshMaterial {
   float specular = 1.0f;  // KHR_materials_specular's specularFactor
   MeshTexture metallic_roughness_map, normal_map;
   float normal_scale = 1.0f;
+  // Alpha (glTF's alphaMode): none (0, opaque), or MASK (alpha below alpha_cutoff is
+  // not there) or BLEND (alpha is the chance of being there), of alpha_factor times
+  // alpha_map's A channel (the base colour texture).
+  uint32_t alpha_mode = 0;  // 0, or an AlphaMode
+  float alpha_factor = 1.0f, alpha_cutoff = 0.5f;
+  MeshTexture alpha_map;
   // The texture coordinates its textures read (glTF: 0 for TEXCOORD_0, 1 for
   // TEXCOORD_1); the mesh's uvs hold that set for this material's triangles.
   int uv_set = 0;

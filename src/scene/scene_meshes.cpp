@@ -77,6 +77,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   }
   // The file's materials join the scene's, named "<mesh>/<material>", unless overridden.
   std::vector<uint32_t> material_of(mesh.materials.size());
+  std::vector<uint32_t> alpha_of(mesh.materials.size(), 0u);  // TriangleGeom::alpha of each
   if (material_override < 0) {
     for (size_t i = 0; i < mesh.materials.size(); ++i) {
       const MeshMaterial& mm = mesh.materials[i];
@@ -118,6 +119,14 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         m.params = static_cast<int32_t>(scene_.material_params.size());
         scene_.material_params.push_back(p);
       }
+      if (mm.alpha_mode != 0) {
+        AlphaTest a{static_cast<AlphaMode>(mm.alpha_mode), -1, mm.alpha_factor, mm.alpha_cutoff};
+        if (!mm.alpha_map.empty()) {
+          a.texture = mm.alpha_map.image == mm.albedo_map.image && m.texture >= 0 ? m.texture : texture_of(mm.alpha_map, true);
+        }
+        alpha_of[i] = static_cast<uint32_t>(scene_.alpha_tests.size()) + 1u;
+        scene_.alpha_tests.push_back(a);
+      }
       material_of[i] = static_cast<uint32_t>(scene_.materials.size());
       scene_.materials.push_back(m);
       scene_.material_names.push_back(name + "/" + mm.name);
@@ -151,6 +160,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& v = mesh.triangles[t];
     TriangleGeom g{};
+    g.alpha = material_override >= 0 ? 0u : alpha_of[mesh.triangle_material[t]];
     for (int c = 0; c < 3; ++c) {
       const vec3& p = mesh.positions[v[c]];
       float* dst = c == 0 ? g.p0 : (c == 1 ? g.p1 : g.p2);

@@ -10,6 +10,7 @@
 
 #include <type_traits>
 
+#include "wavetrace/geometry/alpha.hpp"
 #include "wavetrace/geometry/bvh.hpp"
 #include "wavetrace/geometry/instance.hpp"
 #include "wavetrace/geometry/sphere.hpp"
@@ -89,7 +90,10 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
       }
       case PrimitiveKind::Triangle:
         if (Kinds & kind_bit(PrimitiveKind::Triangle)) {
-          found = intersect_triangle(g.triangle(prim), ray.origin, tr, hit.t, t, b1, b2);
+          const TriangleGeom tri = g.triangle(prim);
+          found = intersect_triangle(tri, ray.origin, tr, hit.t, t, b1, b2);
+          // (The object-space ray: the same for every kernel.)
+          if (found && tri.alpha != 0u) found = alpha_lets_hit(g, tri.alpha, instance, prim, b1, b2, ray);
         }
         break;
     }

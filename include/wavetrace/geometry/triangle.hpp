@@ -14,9 +14,12 @@
 
 namespace wt {
 
-// Corners, padded to 16 bytes each for aligned loads.
+// Corners, padded to 16 bytes each for aligned loads; the first pad says whether
+// the triangle is alpha-tested (geometry/alpha.hpp), so that the traversal learns it
+// from the record it loads anyway and opaque triangles cost one compare.
 struct alignas(16) TriangleGeom {
-  float p0[3], pad0;
+  float p0[3];
+  uint32_t alpha;  // 0: opaque; else 1 + its AlphaTest's index in the scene's alpha_tests
   float p1[3], pad1;
   float p2[3], pad2;
 
