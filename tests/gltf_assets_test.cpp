@@ -113,6 +113,16 @@ struct Doc {
   }
 };
 
+// An RGBA PNG of w x h texels, encoded in memory.
+std::string png_of(int w, int h, const unsigned char* rgba) {
+  std::string out;
+  auto append = [](void* ctx, void* data, int size) {
+    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
+  };
+  EXPECT_NE(stbi_write_png_to_func(append, &out, w, h, 4, rgba, 4 * w), 0);
+  return out;
+}
+
 // A 4 x 4 RGBA PNG: a grey ramp with one red texel at (1, 2).
 std::string marked_png() {
   std::vector<unsigned char> px(4 * 4 * 4);
@@ -125,12 +135,7 @@ std::string marked_png() {
       if (x == 1 && y == 2) p[1] = p[2] = 0, p[0] = 255;
     }
   }
-  std::string out;
-  auto append = [](void* ctx, void* data, int size) {
-    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
-  };
-  EXPECT_NE(stbi_write_png_to_func(append, &out, 4, 4, 4, px.data(), 16), 0);
-  return out;
+  return png_of(4, 4, px.data());
 }
 
 // The red texel, decoded from sRGB (to rounding).
@@ -460,12 +465,7 @@ std::string checker_alpha_png() {
   for (int y = 0; y < 4; ++y) {
     for (int x = 0; x < 4; ++x) px[4 * (4 * y + x) + 3] = (x + y) % 2 == 0 ? 255 : 0;
   }
-  std::string out;
-  auto append = [](void* ctx, void* data, int size) {
-    static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
-  };
-  EXPECT_NE(stbi_write_png_to_func(append, &out, 4, 4, 4, px.data(), 16), 0);
-  return out;
+  return png_of(4, 4, px.data());
 }
 
 // alphaMode MASK cuts the quad out texel by texel: a ray down onto it (a camera's or
@@ -544,12 +544,7 @@ class AlphaLamp : public GltfAssets {
  protected:
   Scene lamp_scene() {
     const unsigned char px[] = {255, 255, 255, 0, 255, 255, 255, 255};  // clear | opaque
-    std::string png;
-    auto append = [](void* ctx, void* data, int size) {
-      static_cast<std::string*>(ctx)->append(static_cast<const char*>(data), static_cast<size_t>(size));
-    };
-    EXPECT_NE(stbi_write_png_to_func(append, &png, 2, 1, 4, px, 8), 0);
-    write("half.png", png);
+    write("half.png", png_of(2, 1, px));
     Doc d;
     d.base_colour({{"uri", "half.png"}}, json::object(), {{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}});
     d.j["materials"][0]["alphaMode"] = "MASK";
