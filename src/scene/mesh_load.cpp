@@ -440,8 +440,8 @@ struct Elements {
   bool normalized = false;
 };
 
-// `count` elements of `elem` bytes from `offset` into buffer view `view` (`stride`
-// apart; 0: the view's own stride, or packed).
+// `count` elements of `elem` bytes from `offset` into buffer view `view_index`, the
+// view's byteStride apart (packed where it has none).
 Elements view_elements(const tinygltf::Model& model, int view_index, size_t offset, size_t count, size_t elem,
                        const std::string& where, const std::string& path) {
   if (view_index < 0 || static_cast<size_t>(view_index) >= model.bufferViews.size()) {

@@ -175,6 +175,14 @@ void build_bvh(Scene& scene) {
   build_lights(scene, instance_mesh);
 }
 
+// The radius of the scene's bounding sphere (about its top-level box); 0 for an
+// empty scene.
+static float scene_radius(const Scene& scene) {
+  if (scene.nodes.empty()) return 0.0f;
+  const Aabb box = node_bounds(scene.nodes[0]);
+  return 0.5f * glm::length(box.hi - box.lo);
+}
+
 // The sky's power as a light, in light_power_of's units (power / pi): the radiance
 // that enters the scene's bounding sphere (radius r) from every direction, mean
 // radiance x 4 pi x pi r^2, over pi. 0 where the sky is not sampled: the gradient
@@ -202,8 +210,7 @@ float sky_light_power(const Scene& scene) {
     }
     mean = weights > 0.0 ? sky.intensity * weighted / weights : 0.0;
   }
-  const Aabb box = node_bounds(scene.nodes[0]);
-  const double r = 0.5 * glm::length(box.hi - box.lo);
+  const double r = scene_radius(scene);
   const double power = mean * 4.0 * kPi * r * r;
   return std::isfinite(power) && power > 0.0 && power < 3.0e38 ? static_cast<float>(power) : 0.0f;
 }
@@ -250,7 +257,7 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
   }
   // Each placed mesh's punctual lights, in world space.
   scene.punctual_lights.clear();
-  const float radius = scene.nodes.empty() ? 0.0f : 0.5f * glm::length(node_bounds(scene.nodes[0]).hi - node_bounds(scene.nodes[0]).lo);
+  const float radius = scene_radius(scene);
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& in = scene.instances[i];
     if (in.kind == PrimitiveKind::Sphere) continue;
