@@ -382,7 +382,8 @@ TEST_F(MeshLoad, GltfTexturesAreFilesBesideTheMesh) {
   const MeshMaterial& mm = m.materials[0];
   EXPECT_EQ(mm.material.kind, MaterialKind::Principled);
   EXPECT_EQ(mm.albedo_map.image, (folder_.root() / "maps/base.png").string());
-  EXPECT_EQ(mm.metallic_roughness_map.image, (folder_.root() / "maps/mr.png").string());
+  EXPECT_EQ(mm.roughness_map.image, (folder_.root() / "maps/mr.png").string());
+  EXPECT_EQ(mm.metallic_map.image, mm.roughness_map.image);
   EXPECT_EQ(mm.normal_map.image, (folder_.root() / "maps/normal.png").string());
   EXPECT_FLOAT_EQ(mm.normal_scale, 0.8f);
 }

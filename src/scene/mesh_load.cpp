@@ -829,7 +829,7 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   if (pbr.baseColorTexture.index >= 0) out.albedo_map = texture(pbr.baseColorTexture, "base colour texture");
   if (out.alpha_mode != 0) out.alpha_map = out.albedo_map;
   if (pbr.metallicRoughnessTexture.index >= 0) {
-    out.metallic_roughness_map = texture(pbr.metallicRoughnessTexture, "metallic-roughness texture");
+    out.roughness_map = out.metallic_map = texture(pbr.metallicRoughnessTexture, "metallic-roughness texture");
   }
   if (g.normalTexture.index >= 0) {
     out.normal_map = texture(g.normalTexture, "normal texture");

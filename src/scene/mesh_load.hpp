@@ -42,9 +42,31 @@ struct MeshMaterial {
   // metallic-roughness texture (G roughness, B metallic) and tangent-space normal
   // map (both linear), the normal map's x and y scaled by normal_scale.
   float roughness = 1.0f, metallic = 0.0f;
+  float anisotropy = 0.0f;  // in [0, 1] (MTL's aniso)
   float specular = 1.0f;  // KHR_materials_specular's specularFactor
-  MeshTexture metallic_roughness_map, normal_map;
+  // The roughness (its G channel) and metallic (its B channel) textures: glTF's
+  // metallicRoughnessTexture is both (one texture), MTL's map_Pr and map_Pm each one.
+  MeshTexture roughness_map, metallic_map, normal_map;
   float normal_scale = 1.0f;
+  // KHR_materials_clearcoat (MTL's Pc, Pcr): the coat's weight and roughness, times
+  // clearcoat_map's R and clearcoat_roughness_map's G; the coat's own normal map
+  // (none: the coat follows the surface, not the base's normal map).
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;
+  MeshTexture clearcoat_map, clearcoat_roughness_map, clearcoat_normal_map;
+  float clearcoat_normal_scale = 1.0f;
+  // KHR_materials_transmission (MTL's Tf): the share of the dielectric base that
+  // transmits (tinted by the base colour), times transmission_map's R. Thin-walled
+  // unless `thin` is false (KHR_materials_volume: the surface bounds a volume that
+  // refracts at `material.ior` and absorbs, Beer-Lambert, to attenuation_color over
+  // attenuation_distance; infinite: clear).
+  float transmission = 0.0f;
+  MeshTexture transmission_map;
+  bool thin = true;
+  vec3 attenuation_color{1.0f};
+  float attenuation_distance = 0.0f;  // 0: infinite
+  // A reflecting material's emission (material.emission) is textured by emission_map
+  // (sRGB); an emitter's (material.kind Emissive) by albedo_map, as above.
+  MeshTexture emission_map;
   // Alpha (glTF's alphaMode): none (0, opaque), or MASK (alpha below alpha_cutoff is
   // not there) or BLEND (alpha is the chance of being there), of alpha_factor times
   // alpha_map's A channel (the base colour texture).

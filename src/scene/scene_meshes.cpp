@@ -111,8 +111,12 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         p.ay = g.ay;
         p.metallic = mm.metallic;
         p.specular = mm.specular;
-        if (!mm.metallic_roughness_map.empty()) {
-          p.roughness_texture = p.metallic_texture = texture_of(mm.metallic_roughness_map, false);
+        if (!mm.roughness_map.empty()) p.roughness_texture = texture_of(mm.roughness_map, false);
+        if (!mm.metallic_map.empty()) {
+          // glTF's one texture for both is looked up once (bsdf_at).
+          p.metallic_texture = mm.metallic_map.image == mm.roughness_map.image && p.roughness_texture >= 0
+                                   ? p.roughness_texture
+                                   : texture_of(mm.metallic_map, false);
         }
         if (!mm.normal_map.empty()) p.normal_texture = texture_of(mm.normal_map, false);
         prepare_microfacet(m, p, scene_.bsdf_tables, shared_tables_);
