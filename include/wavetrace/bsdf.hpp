@@ -29,6 +29,26 @@ struct BsdfInputs {
   const ImageView* images;
 };
 
+// Principled's textured coat (weight: red; roughness: green; its normal map) and
+// transmission (red), looked up where the material has them.
+WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
+  auto channel = [&](int32_t texture, int c) {
+    return fminf(fmaxf(eval_texture(in.textures[texture], in.images, sp)[c], 0.0f), 1.0f);
+  };
+  if (b.p.transmission_texture >= 0) b.p.transmission *= channel(b.p.transmission_texture, 0);
+  if (!(b.p.clearcoat > 0.0f)) return;
+  if (b.p.clearcoat_texture >= 0) b.p.clearcoat *= channel(b.p.clearcoat_texture, 0);
+  if (b.p.coat_roughness_texture >= 0) {
+    const float r = channel(b.p.coat_roughness_texture, 1);
+    b.p.coat_alpha *= r * r;
+  }
+  if (b.p.coat_normal_texture >= 0) {
+    b.coat_n = mapped_normal(sp.n, sp.dpdu, sp.tangent_sign,
+                             eval_texture(in.textures[b.p.coat_normal_texture], in.images, sp), b.p.coat_normal_strength);
+  }
+  b.coat_n = facing_viewer(b.coat_n, wo, b.front);
+}
+
 // The BSDF of material m at sp seen from wo, its albedo there being `albedo`
 // (material_albedo). Where the material has parameters beyond the study's
 // (Microfacet kernels only): its textured roughness and normal map are looked up,
@@ -47,7 +67,8 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
   b.dpdu = sp.dpdu;
   b.front = sp.front;
   b.tables = in.tables;
-  b.p = MaterialParams{0.0f, 0.0f, 0.0f, -1, vec3(0.0f), vec3(0.0f), vec3(0.0f), 1, -1, -1, 1.0f, 0.0f, -1, -1, 1.0f};
+  b.coat_n = sp.n;
+  b.p = MaterialParams{};
   if constexpr (Microfacet) {
     if (m.params >= 0) {
       b.p = in.params[m.params];
@@ -76,6 +97,7 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
                             eval_texture(in.textures[b.p.normal_texture], in.images, sp), b.p.normal_strength);
       }
       b.n = facing_viewer(b.n, wo, b.front);
+      if (b.kind == MaterialKind::Principled) principled_textures(b, in, sp, wo);
     }
   }
   return b;
@@ -100,10 +122,7 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
       if constexpr (Microfacet) return plastic_sample(b, wo, rng);
       break;
     case MaterialKind::Principled:
-      if constexpr (Microfacet) {
-        if ((b.flags & kMaterialOneSided) && !b.front) break;
-        return principled_sample(b, wo, rng);
-      }
+      if constexpr (Microfacet) return principled_sample(b, wo, rng);
       break;
     case MaterialKind::Emissive: break;
   }
@@ -141,9 +160,7 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
       if constexpr (Microfacet) f = plastic_eval(b, wo, wi, pdf);
       break;
     case MaterialKind::Principled:
-      if constexpr (Microfacet) {
-        if (!(b.flags & kMaterialOneSided) || b.front) f = principled_eval(b, wo, wi, pdf);
-      }
+      if constexpr (Microfacet) f = principled_eval(b, wo, wi, pdf);
       break;
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;
@@ -170,7 +187,7 @@ WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
     case MaterialKind::Lambertian:
     case MaterialKind::Coated: return true;
     case MaterialKind::Plastic: return Microfacet;
-    case MaterialKind::Principled: return Microfacet && (!(b.flags & kMaterialOneSided) || b.front);
+    case MaterialKind::Principled: return Microfacet && !principled_culled(b);
     case MaterialKind::Metal: return b.fuzz > 0.0f;
     case MaterialKind::Conductor: return Microfacet && !conductor_ggx(b).smooth();
     case MaterialKind::Glass: return Microfacet && !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();
@@ -182,6 +199,8 @@ WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
 
 // Whether the BSDF can send light through the surface (light sampling then looks
 // on both sides of it).
-WT_HD WT_INLINE bool bsdf_transmits(const BsdfAt& b) { return b.kind == MaterialKind::Glass; }
+WT_HD WT_INLINE bool bsdf_transmits(const BsdfAt& b) {
+  return b.kind == MaterialKind::Glass || (b.kind == MaterialKind::Principled && b.p.transmission > 0.0f);
+}
 
 }  // namespace wt

@@ -23,27 +23,28 @@ constexpr uint32_t kMaterialKindCount = 9;
 
 // Material::flags.
 enum MaterialFlag : uint16_t {
-  kMaterialThin = 1,         // Glass: a thin sheet
+  kMaterialThin = 1,         // Glass: a thin sheet; Principled: its transmission is through a thin wall
   kMaterialSchlick = 2,      // Conductor: Fresnel from f0 (MaterialParams::eta) by Schlick's formula
   kMaterialCompensated = 4,  // Conductor, Glass: the energy lost to multiple scattering is put back
   kMaterialSeparable = 8,    // Conductor, Glass, Plastic, Principled: separable Smith masking (Ggx::separable)
   kMaterialOneSided = 16,    // Principled: a back face reflects nothing (glTF's doubleSided false)
+  kMaterialEmits = 32,       // a kind other than Emissive that also emits (Material::emission)
 };
 
 // The parameters beyond the study's: the microfacet kinds' (conductor, glass,
 // plastic) and any kind's normal map; one per such material, in the scene's
 // material_params (Material::params indexes it).
 struct MaterialParams {
-  float ax, ay;     // GGX alphas along the tangent and across it (below kSmoothAlpha: smooth)
-  float internal;   // Plastic: the coat's diffuse reflectance seen from inside
-  int32_t table;    // the offset of the material's tables in the scene's bsdf_tables (-1: none)
-  vec3 eta;         // Conductor: the real part of the index (or f0 with kMaterialSchlick)
-  vec3 k;           // Conductor: the imaginary part
-  vec3 fresnel_average;  // Conductor: 2 int F(mu) mu dmu per channel (Kulla-Conty's F_avg)
-  int32_t table_rows;         // 1, or kEnergySize rows by roughness where the roughness is textured
-  int32_t roughness_texture;  // -1, or the texture whose green channel scales the roughness
-  int32_t normal_texture;     // -1, or a tangent-space normal map (linear colour)
-  float normal_strength;      // scales the normal map's x and y (glTF's normalTexture.scale)
+  float ax = 0.0f, ay = 0.0f;  // GGX alphas along the tangent and across it (below kSmoothAlpha: smooth)
+  float internal = 0.0f;   // Plastic: the coat's diffuse reflectance seen from inside
+  int32_t table = -1;      // the offset of the material's tables in the scene's bsdf_tables (-1: none)
+  vec3 eta{0.0f};          // Conductor: the real part of the index (or f0 with kMaterialSchlick)
+  vec3 k{0.0f};            // Conductor: the imaginary part
+  vec3 fresnel_average{0.0f};  // Conductor: 2 int F(mu) mu dmu per channel (Kulla-Conty's F_avg)
+  int32_t table_rows = 1;          // 1, or kEnergySize rows by roughness where the roughness is textured
+  int32_t roughness_texture = -1;  // -1, or the texture whose green channel scales the roughness
+  int32_t normal_texture = -1;     // -1, or a tangent-space normal map (linear colour)
+  float normal_strength = 1.0f;    // scales the normal map's x and y (glTF's normalTexture.scale)
   // Plastic: the share of a metal of f0 = albedo at the coat's roughness (glTF's
   // metallic), scaled by metallic_texture's blue channel where it has one; and the
   // metal's energy tables (the conductors', -1: uncompensated).
@@ -53,6 +54,29 @@ struct MaterialParams {
   // Principled: the strength of the dielectric's specular layer (glTF's
   // KHR_materials_specular specularFactor; 0: the base alone, a Lambertian).
   float specular = 1.0f;
+  // Principled: a clear coat (KHR_materials_clearcoat) of weight `clearcoat` (times
+  // clearcoat_texture's red channel) and GGX alpha coat_alpha (its roughness
+  // squared; the roughness times coat_roughness_texture's green channel), with a
+  // normal map of its own (none: the surface's shading normal); coat_table: its
+  // layer table (principled_table at index 1.5).
+  float clearcoat = 0.0f;
+  int32_t clearcoat_texture = -1;
+  float coat_alpha = 0.0f;
+  int32_t coat_roughness_texture = -1;
+  int32_t coat_normal_texture = -1;
+  float coat_normal_strength = 1.0f;
+  int32_t coat_table = -1;
+  // Principled: the share of the dielectric base that transmits
+  // (KHR_materials_transmission, times transmission_texture's red channel), tinted
+  // by the base colour: through a thin wall (kMaterialThin), or refracting into a
+  // volume as `glass` does (glass_table: its energy tables, rows by roughness) that
+  // absorbs `attenuation` per unit length (KHR_materials_volume, Beer-Lambert).
+  float transmission = 0.0f;
+  int32_t transmission_texture = -1;
+  int32_t glass_table = -1;
+  vec3 attenuation{0.0f};
+  // A reflecting material's emission texture (Material::emission times its colour).
+  int32_t emission_texture = -1;
 };
 
 // Kept at 44 bytes: the constant-memory megakernel holds every material of a
@@ -68,7 +92,7 @@ struct Material {
   float ior;        // Dielectric, Coated (the coat), Glass, Plastic (the coat), Principled (the base)
   vec3 albedo;      // Lambertian, Metal, Coated, Plastic (the base), Principled (the base colour);
                     // Dielectric, Glass: transmission tint
-  vec3 emission;    // Emissive
+  vec3 emission;    // Emissive; any other kind with kMaterialEmits
   int32_t params = -1;  // Conductor, Glass, Plastic: index into material_params (-1: none)
 };
 static_assert(sizeof(Material) == 44, "a material grows every constant-memory scene");

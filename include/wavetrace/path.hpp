@@ -62,10 +62,14 @@ WT_HD WT_INLINE vec3 emitted_radiance(const Scene& scene, const Material& m, con
   if constexpr ((Kinds & kMicrofacet) == 0) {
     return m.emission;
   } else {
-    if (m.texture < 0) return m.emission;
+    // An emitter's texture is its emission's; a reflecting material's is a parameter.
+    const int32_t texture = m.kind == MaterialKind::Emissive ? m.texture
+                            : m.params >= 0                  ? scene.material_param_array()[m.params].emission_texture
+                                                             : -1;
+    if (texture < 0) return m.emission;
     SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
     sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
-    return m.emission * eval_texture(scene.texture_array()[m.texture], scene.image_array(), sp);
+    return m.emission * eval_texture(scene.texture_array()[texture], scene.image_array(), sp);
   }
 }
 
@@ -188,17 +192,30 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   shadow.valid = false;
   const Material& m = scene.material(material_index<Kinds>(scene, hit));
   const bool nee = (Kinds & kLightSampling) != 0 && rp.nee != 0 && scene.light_count() > 0;
-  if (m.kind == MaterialKind::Emissive) {
+  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
+  // An emitter adds what it sends out (a reflecting one, kMaterialEmits, then
+  // scatters too).
+  if (m.kind == MaterialKind::Emissive || (kFacets && (m.flags & kMaterialEmits))) {
     float w = 1.0f;
     if (nee && pdf > 0.0f) {
       w = power_heuristic(pdf, light_density(scene, m.emission, emitter_shape<Kinds>(scene, hit.instance, hit.prim),
                                              ray.origin, ray.dir, hit.t));
     }
     radiance += throughput * emitted_radiance<Kinds>(scene, m, ray, hit) * w;
-    return false;
+    if (m.kind == MaterialKind::Emissive) return false;
   }
   SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
-  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
+  // A path that meets a volume's boundary from inside crossed the volume to it:
+  // Beer-Lambert's absorption over the distance (KHR_materials_volume; a closed
+  // surface, volumes not nested).
+  if constexpr (kFacets) {
+    if (m.params >= 0 && !sp.front) {
+      const vec3 sigma = scene.material_param_array()[m.params].attenuation;
+      if (sigma.x > 0.0f || sigma.y > 0.0f || sigma.z > 0.0f) {
+        throughput *= vec3(expf(-sigma.x * hit.t), expf(-sigma.y * hit.t), expf(-sigma.z * hit.t));
+      }
+    }
+  }
   // The footprint that filters the material's image textures (texture_lod).
   if constexpr (kFacets) {
     if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);

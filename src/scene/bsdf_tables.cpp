@@ -225,6 +225,21 @@ std::vector<float> principled_table(float ior, bool separable, bool compensated)
   return t;
 }
 
+void set_principled_layers(MaterialParams& p, Material& m, const PrincipledLayers& l) {
+  p.clearcoat = l.clearcoat;
+  p.coat_alpha = l.clearcoat_roughness * l.clearcoat_roughness;
+  p.coat_normal_strength = l.clearcoat_normal_strength;
+  p.transmission = l.transmission;
+  p.attenuation = vec3(0.0f);
+  if (l.transmission > 0.0f && l.thin) m.flags |= kMaterialThin;
+  if (l.transmission > 0.0f && !l.thin && l.attenuation_distance > 0.0f) {
+    // A channel of colour 0 absorbs all of it: as colour 1e-30 does over the distance.
+    for (int c = 0; c < 3; ++c) {
+      p.attenuation[c] = -std::log(std::fmax(l.attenuation_color[c], 1e-30f)) / l.attenuation_distance;
+    }
+  }
+}
+
 void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>& tables, SharedTables& shared) {
   int32_t* conductor_offsets = shared.conductor;
   const bool separable = (m.flags & kMaterialSeparable) != 0;
@@ -263,12 +278,28 @@ void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>
         if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
         p.metal_table = conductor_offsets[separable];
       }
-      const auto key = std::make_tuple(m.ior, separable, compensate);
-      auto found = shared.principled.find(key);
-      if (found == shared.principled.end()) {
-        found = shared.principled.emplace(key, append(principled_table(m.ior, separable, compensate))).first;
+      auto layer = [&](float ior) {
+        const auto key = std::make_tuple(ior, separable, compensate);
+        auto found = shared.principled.find(key);
+        if (found == shared.principled.end()) {
+          found = shared.principled.emplace(key, append(principled_table(ior, separable, compensate))).first;
+        }
+        return found->second;
+      };
+      p.table = layer(m.ior);
+      // The clear coat: a layer of index 1.5.
+      p.coat_table = p.clearcoat > 0.0f ? layer(1.5f) : -1;
+      // A volume's share is glass, compensated by its tables with a row per
+      // roughness (a texture may set it), shared by index.
+      p.glass_table = -1;
+      if (p.transmission > 0.0f && !(m.flags & kMaterialThin) && compensate) {
+        const auto key = std::make_tuple(m.ior, separable);
+        auto found = shared.glass.find(key);
+        if (found == shared.glass.end()) {
+          found = shared.glass.emplace(key, append(glass_energy_table(m.ior, Ggx{1.0f, 1.0f, separable}, kEnergySize))).first;
+        }
+        p.glass_table = found->second;
       }
-      p.table = found->second;
       break;
     }
     case MaterialKind::Plastic:

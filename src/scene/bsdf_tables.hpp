@@ -38,7 +38,25 @@ std::vector<float> principled_table(float ior, bool separable, bool compensated)
 struct SharedTables {
   int32_t conductor[2] = {-1, -1};  // height-correlated, separable
   std::map<std::tuple<float, bool, bool>, int32_t> principled;  // by (ior, separable, compensated)
+  std::map<std::tuple<float, bool>, int32_t> glass;  // principled volumes': rows by roughness, by (ior, separable)
 };
+
+// The principled kind's coat, transmission and volume as a file gives them: the
+// coat's weight, roughness and normal map strength; the transmitted share, thin
+// walled or a volume that absorbs to attenuation_color over attenuation_distance
+// (0: infinitely far, a clear volume).
+struct PrincipledLayers {
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f, clearcoat_normal_strength = 1.0f;
+  float transmission = 0.0f;
+  bool thin = true;
+  vec3 attenuation_color{1.0f};
+  float attenuation_distance = 0.0f;
+};
+
+// Sets them in the material's params and flags (before prepare_microfacet): the
+// coat's alpha (roughness squared), kMaterialThin, and the volume's absorption
+// coefficient -ln(colour) / distance per channel.
+void set_principled_layers(MaterialParams& p, Material& m, const PrincipledLayers& l);
 
 // Fills the material's params for its kind (alphas already set, eta/k or f0 for
 // conductors): the compensation factors, the internal reflectance, and the tables,

@@ -569,7 +569,9 @@ std::vector<T> read_accessor(const tinygltf::Model& model, int index, const std:
 // any other it uses is a warning (what it adds is not rendered).
 const char* const kReadExtensions[] = {"KHR_materials_emissive_strength", "KHR_materials_ior",
                                        "KHR_materials_specular",          "KHR_texture_transform",
-                                       "KHR_mesh_quantization",           "KHR_lights_punctual"};
+                                       "KHR_mesh_quantization",           "KHR_lights_punctual",
+                                       "KHR_materials_clearcoat",         "KHR_materials_transmission",
+                                       "KHR_materials_volume"};
 
 bool read_extension(const std::string& name) {
   return std::find(std::begin(kReadExtensions), std::end(kReadExtensions), name) != std::end(kReadExtensions);
@@ -609,6 +611,36 @@ bool extension_pair(const tinygltf::ExtensionMap& extensions, const char* extens
   for (int i = 0; i < 2; ++i) {
     if (!v.Get(i).IsNumber() || !std::isfinite(v.Get(i).GetNumberAsDouble())) return false;
     out[i] = static_cast<float>(v.Get(i).GetNumberAsDouble());
+  }
+  return true;
+}
+
+// An extension's textureInfo (index, texCoord, scale, and its own extensions:
+// KHR_texture_transform) as the core's; false where the field is absent. A
+// malformed one is an error naming the field.
+bool extension_texture(const tinygltf::ExtensionMap& extensions, const char* extension, const char* field,
+                       const std::string& path, const std::string& what, tinygltf::NormalTextureInfo& out) {
+  auto e = extensions.find(extension);
+  if (e == extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return false;
+  const tinygltf::Value& v = e->second.Get(field);
+  const std::string where = what + ": " + extension + " " + field;
+  auto whole = [&](const char* key, double fallback) {
+    if (!v.Has(key)) return fallback;
+    const tinygltf::Value& n = v.Get(key);
+    const double d = n.IsNumber() ? n.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+    if (!(d >= 0.0 && d <= 1e6 && d == std::floor(d))) fail(path, where + " " + key + " must be a whole number >= 0");
+    return d;
+  };
+  if (!v.IsObject() || !v.Has("index")) fail(path, where + " must be an object with an index");
+  out.index = static_cast<int>(whole("index", -1.0));
+  out.texCoord = static_cast<int>(whole("texCoord", 0.0));
+  if (v.Has("scale")) {
+    const tinygltf::Value& n = v.Get("scale");
+    out.scale = n.IsNumber() ? n.GetNumberAsDouble() : std::numeric_limits<double>::quiet_NaN();
+  }
+  if (v.Has("extensions") && v.Get("extensions").IsObject()) {
+    const tinygltf::Value& x = v.Get("extensions");
+    for (const std::string& key : x.Keys()) out.extensions[key] = x.Get(key);
   }
   return true;
 }
@@ -801,7 +833,15 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   } else if (g.alphaMode != "OPAQUE") {
     fail(path, what + ": alphaMode '" + g.alphaMode + "' is not OPAQUE, MASK or BLEND");
   }
-  if (std::max(emissive.x, std::max(emissive.y, emissive.z)) > 0.0f) {
+  // What lets light through (transmission) or layers the surface (a coat) makes it
+  // more than an emitter: it reflects, and emits too.
+  const double transmission = extension_number(g.extensions, "KHR_materials_transmission", "transmissionFactor", 0.0);
+  const double clearcoat = extension_number(g.extensions, "KHR_materials_clearcoat", "clearcoatFactor", 0.0);
+  // (A black base's 4% specular layer alone is left out: such a material is an
+  // emitter, as it was before materials could emit.)
+  auto max3 = [](vec3 v) { return std::max(v.x, std::max(v.y, v.z)); };
+  const bool reflects = max3(base) > 0.0f || pbr.baseColorTexture.index >= 0 || transmission != 0.0 || clearcoat != 0.0;
+  if (max3(emissive) > 0.0f && !reflects) {
     out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, emissive);
     if (g.emissiveTexture.index >= 0) out.albedo_map = texture(g.emissiveTexture, "emissive texture");
     if (out.alpha_mode != 0 && pbr.baseColorTexture.index >= 0) {
@@ -826,6 +866,61 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
     }
   }
   out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  if (max3(emissive) > 0.0f) {
+    out.material.emission = emissive;
+    out.material.flags |= kMaterialEmits;
+    if (g.emissiveTexture.index >= 0) out.emission_map = texture(g.emissiveTexture, "emissive texture");
+  }
+  // KHR_materials_clearcoat.
+  tinygltf::NormalTextureInfo info;
+  const char* kCoat = "KHR_materials_clearcoat";
+  out.clearcoat = unit(clearcoat, "KHR_materials_clearcoat clearcoatFactor");
+  out.clearcoat_roughness =
+      unit(extension_number(g.extensions, kCoat, "clearcoatRoughnessFactor", 0.0), "KHR_materials_clearcoat clearcoatRoughnessFactor");
+  if (extension_texture(g.extensions, kCoat, "clearcoatTexture", path, what, info = {})) {
+    out.clearcoat_map = texture(info, "clearcoat texture");
+  }
+  if (extension_texture(g.extensions, kCoat, "clearcoatRoughnessTexture", path, what, info = {})) {
+    out.clearcoat_roughness_map = texture(info, "clearcoat roughness texture");
+  }
+  if (extension_texture(g.extensions, kCoat, "clearcoatNormalTexture", path, what, info = {})) {
+    out.clearcoat_normal_map = texture(info, "clearcoat normal texture");
+    if (!(info.scale >= 0.0 && info.scale <= 1e3)) fail(path, what + ": KHR_materials_clearcoat clearcoatNormalTexture scale must be in [0, 1000]");
+    out.clearcoat_normal_scale = static_cast<float>(info.scale);
+  }
+  // KHR_materials_transmission, and KHR_materials_volume: a volume where its
+  // thickness is not 0 (the thickness itself is a rasteriser's stand-in for the
+  // distance a path tracer measures).
+  out.transmission = unit(transmission, "KHR_materials_transmission transmissionFactor");
+  if (extension_texture(g.extensions, "KHR_materials_transmission", "transmissionTexture", path, what, info = {})) {
+    out.transmission_map = texture(info, "transmission texture");
+  }
+  const char* kVolume = "KHR_materials_volume";
+  const double thickness = extension_number(g.extensions, kVolume, "thicknessFactor", 0.0);
+  if (!(thickness >= 0.0 && thickness <= 1e9)) fail(path, what + ": KHR_materials_volume thicknessFactor must be a number >= 0");
+  out.thin = thickness == 0.0;
+  const double distance = extension_number(g.extensions, kVolume, "attenuationDistance", 0.0);
+  if (!(distance >= 0.0 && distance <= 1e30)) {
+    fail(path, what + ": KHR_materials_volume attenuationDistance must be a number > 0");
+  }
+  auto volume = g.extensions.find(kVolume);
+  if (volume != g.extensions.end() && volume->second.IsObject()) {
+    if (volume->second.Has("attenuationDistance") && distance == 0.0) {
+      fail(path, what + ": KHR_materials_volume attenuationDistance must be a number > 0");
+    }
+    out.attenuation_distance = static_cast<float>(distance);
+    if (volume->second.Has("attenuationColor")) {
+      const tinygltf::Value& c = volume->second.Get("attenuationColor");
+      double rgb[3] = {-1.0, -1.0, -1.0};
+      if (c.IsArray() && c.ArrayLen() == 3) {
+        for (int i = 0; i < 3; ++i) rgb[i] = c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : -1.0;
+      }
+      for (double v : rgb) {
+        if (!(v >= 0.0 && v <= 1.0)) fail(path, what + ": KHR_materials_volume attenuationColor must be 3 numbers in [0, 1]");
+      }
+      out.attenuation_color = vec3(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
+    }
+  }
   if (pbr.baseColorTexture.index >= 0) out.albedo_map = texture(pbr.baseColorTexture, "base colour texture");
   if (out.alpha_mode != 0) out.alpha_map = out.albedo_map;
   if (pbr.metallicRoughnessTexture.index >= 0) {

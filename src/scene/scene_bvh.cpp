@@ -230,7 +230,7 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
     // (Scenes built by hand in the tests may leave out materials they never shade.)
     if (material >= scene.materials.size()) return;
     const Material& m = scene.materials[material];
-    if (m.kind != MaterialKind::Emissive) return;
+    if (m.kind != MaterialKind::Emissive && !(m.flags & kMaterialEmits)) return;
     const float p = light_power_of(m.emission, shape.area());
     if (!(p > 0.0f)) return;
     scene.lights.push_back(LightRef{instance, static_cast<int32_t>(prim)});

@@ -38,7 +38,9 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
        "normal_strength", "metallic", "metallic_texture", "energy_compensation"},
       {"name", "type", "albedo", "texture", "ior", "roughness", "anisotropy", "metallic", "roughness_texture",
        "metallic_texture", "normal_texture", "normal_strength", "energy_compensation", "masking", "double_sided",
-       "specular"},
+       "specular", "clearcoat", "clearcoat_roughness", "clearcoat_texture", "clearcoat_roughness_texture",
+       "clearcoat_normal_texture", "clearcoat_normal_strength", "transmission", "transmission_texture", "thin",
+       "attenuation_color", "attenuation_distance", "emission", "emission_texture"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -67,8 +69,15 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
     m.texture = texture_named(j["texture"], path / "texture");
     texture_kind = static_cast<int>(scene_.textures[m.texture].kind);
   }
-  // An emitter's texture slot is its emission's (it has no albedo).
-  if (j.contains("emission_texture")) m.texture = texture_named(j["emission_texture"], path / "emission_texture");
+  // An emitter's texture slot is its emission's (it has no albedo); a reflecting
+  // kind's emission texture is a parameter (read_params).
+  if (m.kind == MaterialKind::Emissive && j.contains("emission_texture")) {
+    m.texture = texture_named(j["emission_texture"], path / "emission_texture");
+  }
+  if (m.kind != MaterialKind::Emissive && j.contains("emission")) {
+    m.emission = radiance(j["emission"], path / "emission");
+    if (m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f) m.flags |= kMaterialEmits;
+  }
   if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic ||
       m.kind == MaterialKind::Principled || j.contains("normal_texture")) {
     read_params(j, path, m);
@@ -154,6 +163,39 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
         if (!(p.k[c] >= 0.0f)) fail_at(path / "k", "each component must be >= 0");
       }
     }
+  }
+  if (m.kind == MaterialKind::Principled) {
+    auto texture = [&](const char* key) { return j.contains(key) ? texture_named(j[key], path / key) : -1; };
+    PrincipledLayers l;
+    if (j.contains("clearcoat")) l.clearcoat = unit_interval(j["clearcoat"], path / "clearcoat");
+    if (j.contains("clearcoat_roughness")) {
+      l.clearcoat_roughness = unit_interval(j["clearcoat_roughness"], path / "clearcoat_roughness");
+    }
+    if (j.contains("clearcoat_normal_strength")) {
+      l.clearcoat_normal_strength = non_negative(j["clearcoat_normal_strength"], path / "clearcoat_normal_strength");
+    }
+    if (j.contains("transmission")) l.transmission = unit_interval(j["transmission"], path / "transmission");
+    if (j.contains("thin")) l.thin = boolean(j["thin"], path / "thin");
+    if (j.contains("attenuation_color")) l.attenuation_color = colour(j["attenuation_color"], path / "attenuation_color");
+    if (j.contains("attenuation_distance")) {
+      l.attenuation_distance = positive(j["attenuation_distance"], path / "attenuation_distance");
+    }
+    for (const char* key : {"attenuation_color", "attenuation_distance"}) {
+      if (j.contains(key) && l.thin) fail_at(path / key, "a thin wall holds no volume: give \"thin\": false");
+    }
+    // A texture given alone sets its parameter outright (the factor defaults to 1).
+    p.clearcoat_texture = texture("clearcoat_texture");
+    if (p.clearcoat_texture >= 0 && !j.contains("clearcoat")) l.clearcoat = 1.0f;
+    p.coat_roughness_texture = texture("clearcoat_roughness_texture");
+    if (p.coat_roughness_texture >= 0 && !j.contains("clearcoat_roughness")) l.clearcoat_roughness = 1.0f;
+    p.coat_normal_texture = texture("clearcoat_normal_texture");
+    p.transmission_texture = texture("transmission_texture");
+    if (p.transmission_texture >= 0 && !j.contains("transmission")) l.transmission = 1.0f;
+    p.emission_texture = texture("emission_texture");
+    if (p.emission_texture >= 0 && !(m.flags & kMaterialEmits)) {
+      fail_at(path / "emission_texture", "scales the emission: give \"emission\" too");
+    }
+    set_principled_layers(p, m, l);
   }
   if (m.kind == MaterialKind::Glass) {
     if (j.contains("tint")) m.albedo = colour(j["tint"], path / "tint");

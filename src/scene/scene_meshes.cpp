@@ -106,11 +106,23 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         p.table_rows = 1;
         p.roughness_texture = p.normal_texture = -1;
         p.normal_strength = mm.normal_scale;
-        const Ggx g = ggx_from_roughness(mm.roughness, 0.0f);
+        const Ggx g = ggx_from_roughness(mm.roughness, mm.anisotropy);
         p.ax = g.ax;
         p.ay = g.ay;
         p.metallic = mm.metallic;
         p.specular = mm.specular;
+        set_principled_layers(p, m, PrincipledLayers{mm.clearcoat, mm.clearcoat_roughness, mm.clearcoat_normal_scale,
+                                                     mm.transmission, mm.thin, mm.attenuation_color,
+                                                     mm.attenuation_distance});
+        if (!mm.clearcoat_map.empty()) p.clearcoat_texture = texture_of(mm.clearcoat_map, false);
+        if (!mm.clearcoat_roughness_map.empty()) {
+          p.coat_roughness_texture = mm.clearcoat_roughness_map.image == mm.clearcoat_map.image && p.clearcoat_texture >= 0
+                                         ? p.clearcoat_texture
+                                         : texture_of(mm.clearcoat_roughness_map, false);
+        }
+        if (!mm.clearcoat_normal_map.empty()) p.coat_normal_texture = texture_of(mm.clearcoat_normal_map, false);
+        if (!mm.transmission_map.empty()) p.transmission_texture = texture_of(mm.transmission_map, false);
+        if (!mm.emission_map.empty()) p.emission_texture = texture_of(mm.emission_map, true);
         if (!mm.roughness_map.empty()) p.roughness_texture = texture_of(mm.roughness_map, false);
         if (!mm.metallic_map.empty()) {
           // glTF's one texture for both is looked up once (bsdf_at).

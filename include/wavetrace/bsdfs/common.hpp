@@ -105,6 +105,7 @@ struct BsdfAt {
   vec3 n;           // unit shading normal, outward
   vec3 ng;          // unit geometric normal, outward
   vec3 dpdu;        // the tangent hint (SurfacePoint::dpdu)
+  vec3 coat_n;      // Principled with a clear coat: the coat's unit shading normal, outward
   bool front;       // wo is on the outward side of ng
   const float* tables;  // the scene's BSDF tables (bsdf_tables.hpp)
 
