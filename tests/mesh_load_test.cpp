@@ -46,8 +46,28 @@ class MeshLoad : public ::testing::Test {
     }
   }
 
+  // A triangle over the materials of MTL text `mtl` (the OBJ names the library and no
+  // material: its face takes the default one, appended after the library's, which
+  // are all kept in their order). Returns the OBJ's path.
+  std::string mtl_obj(const std::string& mtl) {
+    write("lib.mtl", mtl);
+    return write("lib.obj", "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  }
+  TriangleMesh load_mtl(const std::string& mtl) { return load_mesh(mtl_obj(mtl)); }
+
+  std::string at_root(const std::string& file) const { return (folder_.root() / file).string(); }
+
   test::TestFolder folder_;
 };
+
+// The mesh's material named `name` (nullptr, and a failure, where it has none).
+const MeshMaterial* find(const TriangleMesh& m, const std::string& name) {
+  for (const MeshMaterial& mm : m.materials) {
+    if (mm.name == name) return &mm;
+  }
+  ADD_FAILURE() << "no material '" << name << "'";
+  return nullptr;
+}
 
 void expect_vec(const vec3& got, const vec3& want) {
   EXPECT_FLOAT_EQ(got.x, want.x);
@@ -68,7 +88,7 @@ Ks 0.5 0.5 0.5
 Ni 1.4
 newmtl glass
 Kd 0 0 0
-d 0.25
+illum 7
 Ni 1.33
 newmtl lamp
 Kd 0.5 0.5 0.5
@@ -157,17 +177,21 @@ TEST_F(MeshLoad, ObjGivesPositionsNormalsUvsTrianglesAndMaterials) {
   expect_vec(lacquer.albedo, vec3(0.2f, 0.3f, 0.4f));
   EXPECT_FLOAT_EQ(lacquer.ior, 1.4f);
 
-  const Material& glass = m.materials[3].material;
-  EXPECT_EQ(glass.kind, MaterialKind::Dielectric);
-  EXPECT_FLOAT_EQ(glass.ior, 1.33f);
-  expect_vec(glass.albedo, vec3(1.0f));
+  // A glass (illum 7 is refraction): principled, transmitting, white where Tf is not written.
+  const MeshMaterial& glass = m.materials[3];
+  EXPECT_EQ(glass.material.kind, MaterialKind::Principled);
+  EXPECT_FLOAT_EQ(glass.material.ior, 1.33f);
+  expect_vec(glass.material.albedo, vec3(1.0f));
+  EXPECT_EQ(glass.transmission, 1.0f);
 
   const Material& lamp = m.materials[4].material;
   EXPECT_EQ(lamp.kind, MaterialKind::Emissive);
   expect_vec(lamp.emission, vec3(4, 3, 2));
   for (const MeshMaterial& mm : m.materials) {
     EXPECT_EQ(mm.material.sort_key, material_sort_key(mm.material.kind, -1)) << mm.name;
+    EXPECT_EQ(mm.alpha_mode, 0u) << mm.name;
   }
+  EXPECT_TRUE(m.warnings.empty());
 }
 
 TEST_F(MeshLoad, ObjWithoutMaterialsNormalsOrUvsGetsTheDefaultMaterial) {
@@ -211,6 +235,345 @@ TEST_F(MeshLoad, ObjErrorsNameTheFileAndTheProblem) {
   write("bright.mtl", "newmtl bright\nKd 1.5 1 1\n");
   expect_error(write("bright.obj", "mtllib bright.mtl\nusemtl bright\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
                "material 'bright': Kd must be 3 numbers in [0, 1]");
+}
+
+// ---- MTL materials ----
+
+// The PBR extension's values reach the principled material's fields; Kd is the base
+// colour and Ni the index.
+TEST_F(MeshLoad, MtlPbrKeysMakeAPrincipledMaterialWithTheirValues) {
+  const TriangleMesh m = load_mtl(R"(newmtl brushed
+Kd 0.8 0.6 0.4
+Ks 0.5 0.5 0.5
+Ns 200
+Ni 1.6
+Pr 0.35
+Pm 0.75
+Pc 0.5
+Pcr 0.125
+aniso 0.25
+)");
+  ASSERT_EQ(m.materials.size(), 2u);  // and the default
+  const MeshMaterial& mm = m.materials[0];
+  EXPECT_EQ(mm.name, "brushed");
+  EXPECT_EQ(mm.material.kind, MaterialKind::Principled);
+  expect_vec(mm.material.albedo, vec3(0.8f, 0.6f, 0.4f));
+  EXPECT_FLOAT_EQ(mm.material.ior, 1.6f);
+  EXPECT_TRUE(mm.material.flags & kMaterialCompensated);
+  EXPECT_FALSE(mm.material.flags & kMaterialOneSided);
+  EXPECT_EQ(mm.material.sort_key, material_sort_key(MaterialKind::Principled, -1));
+  EXPECT_FLOAT_EQ(mm.roughness, 0.35f);
+  EXPECT_FLOAT_EQ(mm.metallic, 0.75f);
+  EXPECT_FLOAT_EQ(mm.clearcoat, 0.5f);
+  EXPECT_FLOAT_EQ(mm.clearcoat_roughness, 0.125f);
+  EXPECT_FLOAT_EQ(mm.anisotropy, 0.25f);
+  EXPECT_FLOAT_EQ(mm.specular, 1.0f);
+  EXPECT_EQ(mm.transmission, 0.0f);
+  EXPECT_TRUE(mm.albedo_map.empty());
+  EXPECT_TRUE(mm.normal_map.empty());
+  EXPECT_EQ(mm.alpha_mode, 0u);
+  EXPECT_TRUE(m.warnings.empty());
+}
+
+// Whether a material is PBR is whether it writes a PBR key, not whether the value
+// differs from tinyobjloader's default: Pr 0 is a smooth principled surface. Where Pr
+// is not written the surface is matte (roughness 1).
+TEST_F(MeshLoad, MtlPbrKeyWrittenAsZeroStillMakesAPrincipledMaterial) {
+  const TriangleMesh m = load_mtl("newmtl smooth\nKd 0.5 0.5 0.5\nPr 0\nnewmtl metal\nKd 0.9 0.9 0.9\nPm 1\n"
+                                  "newmtl plain\nKd 0.5 0.5 0.5\n");
+  const MeshMaterial* smooth = find(m, "smooth");
+  const MeshMaterial* metal = find(m, "metal");
+  const MeshMaterial* plain = find(m, "plain");
+  ASSERT_TRUE(smooth && metal && plain);
+  EXPECT_EQ(smooth->material.kind, MaterialKind::Principled);
+  EXPECT_EQ(smooth->roughness, 0.0f);
+  EXPECT_EQ(smooth->metallic, 0.0f);
+  EXPECT_EQ(metal->material.kind, MaterialKind::Principled);
+  EXPECT_EQ(metal->roughness, 1.0f);
+  EXPECT_EQ(metal->metallic, 1.0f);
+  EXPECT_EQ(plain->material.kind, MaterialKind::Lambertian);
+}
+
+// map_Kd (sRGB base colour), map_Pr, map_Pm and norm are files resolved against the
+// mesh's folder; a map written without its value scales 1 (the map alone).
+TEST_F(MeshLoad, MtlPbrMapsAreFilesBesideTheMesh) {
+  const TriangleMesh m = load_mtl(R"(newmtl painted
+map_Kd maps/base.png
+map_Pr maps/rough.png
+map_Pm maps/metal.png
+norm -bm 0.5 maps/normal.png
+newmtl scaled
+Kd 0.5 0.5 0.5
+Pr 0.5
+Pm 0.25
+map_Pr r.png
+map_Pm m.png
+)");
+  const MeshMaterial* painted = find(m, "painted");
+  const MeshMaterial* scaled = find(m, "scaled");
+  ASSERT_TRUE(painted && scaled);
+  EXPECT_EQ(painted->material.kind, MaterialKind::Principled);
+  EXPECT_EQ(painted->albedo_map.image, at_root("maps/base.png"));
+  EXPECT_EQ(painted->roughness_map.image, at_root("maps/rough.png"));
+  EXPECT_EQ(painted->metallic_map.image, at_root("maps/metal.png"));
+  EXPECT_EQ(painted->normal_map.image, at_root("maps/normal.png"));
+  EXPECT_FLOAT_EQ(painted->normal_scale, 0.5f);
+  expect_vec(painted->material.albedo, vec3(1.0f));  // not tinyobjloader's 0.6 under a map_Kd
+  EXPECT_EQ(painted->roughness, 1.0f);
+  EXPECT_EQ(painted->metallic, 1.0f);
+  EXPECT_EQ(painted->material.texture, -1);
+  // Written with their maps, the values scale them.
+  EXPECT_FLOAT_EQ(scaled->roughness, 0.5f);
+  EXPECT_FLOAT_EQ(scaled->metallic, 0.25f);
+  EXPECT_EQ(scaled->roughness_map.image, at_root("r.png"));
+  EXPECT_EQ(scaled->metallic_map.image, at_root("m.png"));
+  EXPECT_TRUE(scaled->albedo_map.empty());
+  EXPECT_TRUE(m.warnings.empty());
+}
+
+// A PBR material's bump map is its tangent-space normal map, -bm its strength; a
+// classic material's is MTL's height map, which is warned of and not read; norm wins
+// over a bump map.
+TEST_F(MeshLoad, MtlBumpMapIsTheNormalMapOfAPbrMaterialWithBmItsStrength) {
+  const TriangleMesh m = load_mtl(R"(newmtl pbr
+Kd 0.5 0.5 0.5
+Pr 0.5
+map_Bump -bm 0.3 tex/normal.png
+newmtl classic
+Kd 0.5 0.5 0.5
+bump -bm 2 tex/height.png
+newmtl both
+Pr 0.5
+norm tex/n.png
+bump tex/h.png
+)");
+  const MeshMaterial* pbr = find(m, "pbr");
+  const MeshMaterial* classic = find(m, "classic");
+  const MeshMaterial* both = find(m, "both");
+  ASSERT_TRUE(pbr && classic && both);
+  EXPECT_EQ(pbr->normal_map.image, at_root("tex/normal.png"));
+  EXPECT_FLOAT_EQ(pbr->normal_scale, 0.3f);
+  EXPECT_EQ(classic->material.kind, MaterialKind::Lambertian);
+  EXPECT_TRUE(classic->normal_map.empty());
+  EXPECT_EQ(both->normal_map.image, at_root("tex/n.png"));
+  EXPECT_FLOAT_EQ(both->normal_scale, 1.0f);
+  ASSERT_EQ(m.warnings.size(), 2u);
+  EXPECT_NE(m.warnings[0].find("material 'classic': its bump map 'tex/height.png' is a height map"), std::string::npos)
+      << m.warnings[0];
+  EXPECT_NE(m.warnings[1].find("material 'both': its bump map is not read: norm gives its normal map"), std::string::npos)
+      << m.warnings[1];
+}
+
+// MTL's dissolve is coverage: d (or 1 - Tr) times map_d's A channel, as alpha BLEND,
+// whatever the material's kind; d 1 without a map is opaque.
+TEST_F(MeshLoad, MtlDissolveAndMapDAreAlphaBlend) {
+  const TriangleMesh m = load_mtl(R"(newmtl veil
+Kd 0.5 0.5 0.5
+d 0.25
+newmtl leaf
+Kd 0.2 0.6 0.1
+d 0.5
+map_d leaf_alpha.png
+newmtl tr
+Kd 0.5 0.5 0.5
+Tr 0.75
+newmtl solid
+Kd 0.5 0.5 0.5
+d 1
+)");
+  const MeshMaterial* veil = find(m, "veil");
+  const MeshMaterial* leaf = find(m, "leaf");
+  const MeshMaterial* tr = find(m, "tr");
+  const MeshMaterial* solid = find(m, "solid");
+  ASSERT_TRUE(veil && leaf && tr && solid);
+  EXPECT_EQ(veil->material.kind, MaterialKind::Lambertian);  // not a glass
+  EXPECT_EQ(veil->alpha_mode, static_cast<uint32_t>(AlphaMode::Blend));
+  EXPECT_FLOAT_EQ(veil->alpha_factor, 0.25f);
+  EXPECT_TRUE(veil->alpha_map.empty());
+  EXPECT_EQ(leaf->alpha_mode, static_cast<uint32_t>(AlphaMode::Blend));
+  EXPECT_FLOAT_EQ(leaf->alpha_factor, 0.5f);
+  EXPECT_EQ(leaf->alpha_map.image, at_root("leaf_alpha.png"));
+  EXPECT_EQ(tr->alpha_mode, static_cast<uint32_t>(AlphaMode::Blend));
+  EXPECT_FLOAT_EQ(tr->alpha_factor, 0.25f);
+  EXPECT_EQ(solid->alpha_mode, 0u);
+  EXPECT_TRUE(m.warnings.empty());
+}
+
+// Tf (with no illum written) or an illumination model with refraction (4, 6, 7, 9)
+// is a principled glass: transmitting, a volume refracting at Ni, tinted by Tf,
+// smooth unless Pr says otherwise. Tf under a model without refraction is not read.
+TEST_F(MeshLoad, MtlTransmissionFilterOrRefractingIllumIsAPrincipledGlass) {
+  const TriangleMesh m = load_mtl(R"(newmtl tinted
+Kd 0.1 0.1 0.1
+Tf 0.9 0.8 0.7
+Ni 1.33
+newmtl clear
+illum 7
+newmtl frosted
+illum 4
+Ni 1.45
+Pr 0.2
+newmtl opaque
+Kd 0.5 0.5 0.5
+Tf 1 1 1
+illum 2
+)");
+  const MeshMaterial* tinted = find(m, "tinted");
+  const MeshMaterial* clear = find(m, "clear");
+  const MeshMaterial* frosted = find(m, "frosted");
+  const MeshMaterial* opaque = find(m, "opaque");
+  ASSERT_TRUE(tinted && clear && frosted && opaque);
+  for (const MeshMaterial* glass : {tinted, clear, frosted}) {
+    EXPECT_EQ(glass->material.kind, MaterialKind::Principled) << glass->name;
+    EXPECT_EQ(glass->transmission, 1.0f) << glass->name;
+    EXPECT_FALSE(glass->thin) << glass->name;
+    EXPECT_EQ(glass->metallic, 0.0f) << glass->name;
+  }
+  expect_vec(tinted->material.albedo, vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_FLOAT_EQ(tinted->material.ior, 1.33f);
+  EXPECT_EQ(tinted->roughness, 0.0f);
+  expect_vec(clear->material.albedo, vec3(1.0f));
+  EXPECT_FLOAT_EQ(clear->material.ior, 1.5f);  // Ni not written
+  EXPECT_FLOAT_EQ(frosted->roughness, 0.2f);
+  EXPECT_FLOAT_EQ(frosted->material.ior, 1.45f);
+  EXPECT_EQ(opaque->material.kind, MaterialKind::Lambertian);
+  EXPECT_EQ(opaque->transmission, 0.0f);
+}
+
+// Each key that is read and not rendered gives one warning line naming the
+// library, the material and the key.
+TEST_F(MeshLoad, MtlSheenAnisotropyRotationAndSpecularMapsAreWarnedOfOnceEach) {
+  const TriangleMesh m = load_mtl(R"(newmtl velvet
+Kd 0.5 0.1 0.1
+Pr 0.8
+Ps 0.5
+map_Ps sheen.png
+anisor 0.25
+newmtl phong
+Kd 0.5 0.5 0.5
+Ks 0.2 0.2 0.2
+map_Ks spec.png
+map_Ns gloss.png
+)");
+  const std::vector<std::string> want = {
+      "mtllib lib.mtl: material 'velvet': Ps (sheen) is not rendered",
+      "mtllib lib.mtl: material 'velvet': map_Ps (sheen) is not rendered",
+      "mtllib lib.mtl: material 'velvet': anisor (anisotropy rotation) is not rendered",
+      "mtllib lib.mtl: material 'phong': map_Ks is not read",
+      "mtllib lib.mtl: material 'phong': map_Ns is not read",
+  };
+  ASSERT_EQ(m.warnings.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(m.warnings[i].rfind(want[i], 0), 0u) << m.warnings[i];
+    EXPECT_EQ(m.warnings[i].find('\n'), std::string::npos) << m.warnings[i];
+  }
+  // What is read of them still is: velvet is principled, phong keeps its classic kind.
+  EXPECT_EQ(m.materials[0].material.kind, MaterialKind::Principled);
+  EXPECT_FLOAT_EQ(m.materials[0].roughness, 0.8f);
+  EXPECT_EQ(m.materials[1].material.kind, MaterialKind::Coated);
+}
+
+// The renderer reads roughness from G, metallic from B and coverage from A: an
+// -imfchan that names another channel is warned of (b for metallic is the one read).
+TEST_F(MeshLoad, MtlImfchanOtherThanTheChannelReadIsWarnedOf) {
+  const TriangleMesh m = load_mtl(R"(newmtl orm
+Pr 1
+map_Pr -imfchan r orm.png
+map_Pm -imfchan b orm.png
+map_d -imfchan l mask.png
+)");
+  ASSERT_EQ(m.warnings.size(), 2u);
+  EXPECT_EQ(m.warnings[0],
+            "mtllib lib.mtl: material 'orm': map_Pr -imfchan r is not honoured: its roughness is read from the image's "
+            "G channel");
+  EXPECT_EQ(m.warnings[1],
+            "mtllib lib.mtl: material 'orm': map_d -imfchan l is not honoured: its coverage is read from the image's "
+            "A channel");
+  EXPECT_EQ(m.materials[0].metallic_map.image, at_root("orm.png"));
+  EXPECT_EQ(m.materials[0].alpha_map.image, at_root("mask.png"));
+}
+
+// Every bad value is one error naming the file, the library, the material and the key.
+TEST_F(MeshLoad, MtlValuesOutOfRangeAreRefused) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"Pr 1.5", "Pr must be a number in [0, 1]"},
+      {"Pr rough", "Pr must be a number in [0, 1]"},
+      {"Pm -0.1", "Pm must be a number in [0, 1]"},
+      {"Pc -1", "Pc must be a number in [0, 1]"},
+      {"Pcr 2", "Pcr must be a number in [0, 1]"},
+      {"aniso 3", "aniso must be a number in [0, 1]"},
+      {"Pr 0.5\nnorm -bm -1 n.png", "norm -bm must be in [0, 1000]"},
+      {"Pr 0.5\nmap_Bump -bm 2000 n.png", "map_Bump -bm must be in [0, 1000]"},
+      {"map_Pr -bm 1", "map_Pr names no image"},
+      {"Tf 1.5 1 1", "Tf must be 3 numbers in [0, 1]"},
+      {"d -halo 0.5", "d must be a number in [0, 1]"},
+      {"Tr 2", "Tr must be a number in [0, 1]"},
+      {"Ni 0", "Ni must be a number > 0"},
+      {"Ns -1", "Ns must be a number >= 0"},
+      {"illum 12", "illum must be a number in [0, 10]"},
+  };
+  for (const auto& [line, message] : cases) {
+    expect_error(mtl_obj(std::string("newmtl bad\nKd 0.5 0.5 0.5\n") + line + "\n"),
+                 std::string("mtllib lib.mtl: material 'bad': ") + message);
+  }
+}
+
+// An emitter's texture is map_Ke (Ke times it); map_Kd stays unread on it, as before.
+TEST_F(MeshLoad, MtlEmitterTakesMapKeAsItsTexture) {
+  const TriangleMesh m = load_mtl("newmtl screen\nKe 2 2 2\nmap_Kd base.png\nmap_Ke glow.png\n");
+  ASSERT_EQ(m.materials[0].material.kind, MaterialKind::Emissive);
+  expect_vec(m.materials[0].material.emission, vec3(2.0f));
+  EXPECT_EQ(m.materials[0].albedo_map.image, at_root("glow.png"));
+  EXPECT_TRUE(m.warnings.empty());
+}
+
+// The shipped scenes' materials and the references' (whose golden images and
+// converged references were rendered with them) load as they always have.
+TEST_F(MeshLoad, MtlShippedMaterialsAreUnchanged) {
+  struct Want {
+    const char* name;
+    MaterialKind kind;
+    vec3 albedo, emission;
+  };
+  const std::vector<Want> cornell = {
+      {"white", MaterialKind::Lambertian, vec3(0.73f), vec3(0.0f)},
+      {"red", MaterialKind::Lambertian, vec3(0.65f, 0.05f, 0.05f), vec3(0.0f)},
+      {"green", MaterialKind::Lambertian, vec3(0.12f, 0.45f, 0.15f), vec3(0.0f)},
+      {"light", MaterialKind::Emissive, vec3(0.0f), vec3(17.0f, 12.0f, 4.0f)},
+  };
+  const std::vector<Want> room = {
+      {"white", MaterialKind::Lambertian, vec3(0.75f, 0.75f, 0.72f), vec3(0.0f)},
+      {"red", MaterialKind::Lambertian, vec3(0.7f, 0.08f, 0.06f), vec3(0.0f)},
+      {"green", MaterialKind::Lambertian, vec3(0.12f, 0.5f, 0.15f), vec3(0.0f)},
+      {"lamp", MaterialKind::Emissive, vec3(0.0f), vec3(12.0f, 10.0f, 7.0f)},
+  };
+  const std::vector<Want> quad = {{"picture", MaterialKind::Lambertian, vec3(1.0f), vec3(0.0f)}};
+  const std::pair<const char*, const std::vector<Want>*> files[] = {
+      {"scenes/cornell-box.obj", &cornell},
+      {"scenes/cornell-materials-room.obj", &cornell},
+      {"tests/data/references/room.obj", &room},
+      {"tests/data/references/textured-quad.obj", &quad},
+  };
+  for (const auto& [file, want] : files) {
+    const TriangleMesh m = load_mesh(test::repo_path(file));
+    EXPECT_TRUE(m.warnings.empty()) << file;
+    for (const Want& w : *want) {
+      const MeshMaterial* mm = find(m, w.name);
+      ASSERT_TRUE(mm) << file;
+      const Material& got = mm->material;
+      EXPECT_EQ(got.kind, w.kind) << file << " " << w.name;
+      expect_vec(got.albedo, w.albedo);
+      expect_vec(got.emission, w.emission);
+      EXPECT_EQ(got.texture, -1) << file << " " << w.name;
+      EXPECT_EQ(got.fuzz, 0.0f) << file << " " << w.name;
+      EXPECT_EQ(got.ior, 1.0f) << file << " " << w.name;
+      EXPECT_EQ(got.flags, 0u) << file << " " << w.name;
+      EXPECT_EQ(got.sort_key, material_sort_key(w.kind, -1)) << file << " " << w.name;
+      EXPECT_EQ(mm->alpha_mode, 0u) << file << " " << w.name;
+      EXPECT_TRUE(mm->normal_map.empty()) << file << " " << w.name;
+      EXPECT_EQ(mm->albedo_map.empty(), std::string(w.name) != "picture") << file << " " << w.name;
+    }
+  }
 }
 
 // ---- glTF ----

@@ -170,25 +170,160 @@ bool textured(MaterialKind kind) {
 
 // ---- Wavefront OBJ + MTL ----
 
-MeshMaterial map_mtl(const tinyobj::material_t& t, const fs::path& dir, const std::string& path) {
-  const std::string& name = t.name;
-  vec3 kd = checked_colour(path, name, "Kd", t.diffuse, false);
-  vec3 ks = checked_colour(path, name, "Ks", t.specular, false);
-  vec3 ke = checked_colour(path, name, "Ke", t.emission, true);
-  if (!std::isfinite(t.shininess) || t.shininess < 0.0f) fail(path, "material '" + name + "': Ns must be >= 0");
-  if (!std::isfinite(t.ior) || t.ior <= 0.0f) fail(path, "material '" + name + "': Ni must be > 0");
-  if (!std::isfinite(t.dissolve) || t.dissolve < 0.0f || t.dissolve > 1.0f) {
-    fail(path, "material '" + name + "': d must be in [0, 1]");
+// The keys an MTL material writes, each with its value as written (the rest of its
+// line), and the library that holds it. tinyobjloader gives an absent key its default
+// (Pr 0, Pm 0, illum 0, Kd 0.6 beside a map_Kd), which a key written as that value
+// cannot be told from, and reads a value it cannot parse as that default too; what a
+// material becomes depends on which keys it writes, so they are read from the text.
+struct MtlKeys {
+  std::string library;  // the mtllib name, as the OBJ file writes it
+  std::map<std::string, std::string> values;
+  bool has(const char* key) const { return values.count(key) != 0; }
+};
+
+// The keys of each material of an MTL file, in the order tinyobjloader's LoadMtl
+// appends the materials: one per newmtl, or one (unnamed) for a file with none. Lines
+// are split and trimmed as LoadMtl splits them; those before the first newmtl belong
+// to a material it drops.
+std::vector<MtlKeys> mtl_keys(const std::string& text, const std::string& library) {
+  std::vector<MtlKeys> out;
+  MtlKeys current{library, {}};
+  bool named = false;
+  for (size_t at = 0; at < text.size();) {
+    const size_t end = std::min(text.find_first_of("\r\n", at), text.size());
+    std::string line = text.substr(at, end - at);
+    at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
+    line.erase(line.find_last_not_of(" \t") + 1);
+    const size_t begin = line.find_first_not_of(" \t");
+    if (begin == std::string::npos || line[begin] == '#') continue;
+    const size_t space = line.find_first_of(" \t", begin);
+    const std::string key = line.substr(begin, space - begin);
+    if (key == "newmtl" && space != std::string::npos) {
+      if (named) out.push_back(std::move(current));
+      current = MtlKeys{library, {}};
+      named = true;
+      continue;
+    }
+    current.values[key] = space == std::string::npos ? "" : line.substr(line.find_first_not_of(" \t", space));
   }
+  out.push_back(std::move(current));
+  return out;
+}
+
+// Whether a scalar key's value is one finite number (a trailing comment aside).
+bool one_number(std::string text) {
+  text.erase(std::min(text.find('#'), text.size()));
+  text.erase(text.find_last_not_of(" \t") + 1);
+  char* stop = nullptr;
+  const double v = std::strtod(text.c_str(), &stop);
+  return !text.empty() && stop == text.c_str() + text.size() && std::isfinite(v);
+}
+
+// The keys of the MTL PBR extension; a material that writes any of them is
+// `principled`. Ps, map_Ps and anisor among them are not rendered (a warning each).
+const char* const kMtlPbrKeys[] = {"Pr",     "Pm",   "Pc", "Pcr",    "aniso", "map_Pr",
+                                   "map_Pm", "norm", "Ps", "map_Ps", "anisor"};
+
+MeshMaterial map_mtl(const tinyobj::material_t& t, const MtlKeys& k, const fs::path& dir, TriangleMesh& mesh) {
+  const std::string& name = t.name;
+  const std::string& path = mesh.source;
+  // Errors and warnings name the library the material is in, after the OBJ file.
+  const std::string where = k.library.empty() ? path : path + ": mtllib " + k.library;
+  const std::string what = (k.library.empty() ? "" : "mtllib " + k.library + ": ") + "material '" + name + "'";
+  auto warn = [&](const std::string& line) { mesh.warnings.push_back(what + ": " + line); };
+  // A scalar key: one number (checked on the text, which tinyobjloader would read as
+  // the key's default where it is not one) for which `ok` holds.
+  auto number = [&](const char* key, float value, bool ok, const char* range) {
+    if ((k.has(key) && !one_number(k.values.at(key))) || !std::isfinite(value) || !ok) {
+      fail(path, what + ": " + key + " must be a number " + range);
+    }
+    return value;
+  };
+  auto unit = [&](const char* key, float value) {
+    return number(key, value, value >= 0.0f && value <= 1.0f, "in [0, 1]");
+  };
+  vec3 kd = checked_colour(where, name, "Kd", t.diffuse, false);
+  vec3 ks = checked_colour(where, name, "Ks", t.specular, false);
+  vec3 ke = checked_colour(where, name, "Ke", t.emission, true);
+  vec3 tf = checked_colour(where, name, k.has("Kt") && !k.has("Tf") ? "Kt" : "Tf", t.transmittance, false);
+  number("Ns", t.shininess, t.shininess >= 0.0f, ">= 0");
+  number("Ni", t.ior, t.ior > 0.0f, "> 0");
+  // tinyobjloader reads Tr as 1 - d where the material has no d.
+  number(k.has("Tr") && !k.has("d") ? "Tr" : "d", t.dissolve, t.dissolve >= 0.0f && t.dissolve <= 1.0f, "in [0, 1]");
+  number("illum", static_cast<float>(t.illum), t.illum >= 0 && t.illum <= 10, "in [0, 10]");
+  const float pr = unit("Pr", t.roughness), pm = unit("Pm", t.metallic);
+  const float pc = unit("Pc", t.clearcoat_thickness), pcr = unit("Pcr", t.clearcoat_roughness);
+  const float aniso = unit("aniso", t.anisotropy);
+  // A map key that names no image (only options, or nothing) is an error.
+  const std::pair<const char*, const std::string*> maps[] = {
+      {"map_Kd", &t.diffuse_texname}, {"map_Ke", &t.emissive_texname}, {"map_Pr", &t.roughness_texname},
+      {"map_Pm", &t.metallic_texname}, {"norm", &t.normal_texname},     {"map_d", &t.alpha_texname},
+      {"map_Bump", &t.bump_texname},   {"map_bump", &t.bump_texname},   {"bump", &t.bump_texname}};
+  for (const auto& [key, image] : maps) {
+    if (k.has(key) && image->empty()) fail(path, what + ": " + key + " names no image");
+  }
+  auto texture = [&](const std::string& image) {
+    MeshTexture out;
+    out.image = (dir / image).lexically_normal().string();
+    return out;
+  };
+  // The renderer reads roughness from a map's G channel, metallic from B and alpha
+  // from A; an -imfchan naming another is not honoured. tinyobjloader's default is m
+  // (none written); l (luminance) is G or B alike in the grey images these usually are.
+  auto channel = [&](const char* key, const tinyobj::texture_option_t& o, char reads, const char* read) {
+    if (o.imfchan != reads && o.imfchan != 'm' && !(o.imfchan == 'l' && reads != 'm')) {
+      const std::string from = reads == 'm' ? "A" : std::string(1, static_cast<char>(std::toupper(reads)));
+      warn(std::string(key) + " -imfchan " + o.imfchan + " is not honoured: its " + read + " is read from the image's " +
+           from + " channel");
+    }
+  };
   // Ni of 1 (or less) is the MTL default, meaning "not given": a coat or a glass gets 1.5.
-  float ior = t.ior > 1.0f ? t.ior : 1.5f;
+  const float ior = t.ior > 1.0f ? t.ior : 1.5f;
   auto max3 = [](vec3 v) { return std::max(v.x, std::max(v.y, v.z)); };
+  bool pbr = false;
+  for (const char* key : kMtlPbrKeys) pbr = pbr || k.has(key);
+  // Glass is what the illumination models with refraction (4, 6, 7, 9) describe, or a
+  // transmission filter where no model is written; a model without refraction leaves
+  // Tf unread (exporters write Tf 1 1 1 on opaque materials).
+  const bool glass = k.has("illum") ? t.illum == 4 || t.illum == 6 || t.illum == 7 || t.illum == 9 : max3(tf) > 0.0f;
+  // map_Kd is multiplied by Kd (as every MTL map by its key); where Kd is not written
+  // the map is the colour itself, not tinyobjloader's 0.6 grey times it.
+  if (!k.has("Kd") && !t.diffuse_texname.empty()) kd = vec3(1.0f);
   MeshMaterial out;
   out.name = name;
   if (max3(ke) > 0.0f) {
     out.material = make_material(MaterialKind::Emissive, vec3(0.0f), 0.0f, 1.0f, ke);
-  } else if (t.dissolve < 1.0f) {
-    out.material = make_material(MaterialKind::Dielectric, vec3(1.0f), 0.0f, ior, vec3(0.0f));
+    // An emitter's albedo texture is its emission's (Ke times map_Ke).
+    if (!t.emissive_texname.empty()) out.albedo_map = texture(t.emissive_texname);
+  } else if (glass || pbr) {
+    // A glass's colour is its filter (white where Tf is black: a filter that passes
+    // nothing is no glass), its surface smooth unless Pr says otherwise; an opaque
+    // material's colour is Kd, its roughness 1 (matte) where Pr is not written.
+    out.material = make_material(MaterialKind::Principled, glass ? (max3(tf) > 0.0f ? tf : vec3(1.0f)) : kd, 0.0f, 1.0f,
+                                 vec3(0.0f));
+    out.material.ior = ior;
+    out.material.flags = kMaterialCompensated;  // MTL has no sidedness: both sides reflect
+    // A map scales its value (Pr, Pm), which is 1 where the map is written alone.
+    out.roughness = k.has("Pr") ? pr : !t.roughness_texname.empty() ? 1.0f : glass ? 0.0f : 1.0f;
+    out.metallic = k.has("Pm") ? pm : !t.metallic_texname.empty() ? 1.0f : 0.0f;
+    out.clearcoat = pc;
+    out.clearcoat_roughness = pcr;
+    out.anisotropy = aniso;
+    if (glass) {
+      out.transmission = 1.0f;
+      out.thin = false;  // a volume, refracting at Ni
+      if (!t.diffuse_texname.empty()) warn("map_Kd is not read: a glass's colour is its Tf");
+    } else if (!t.diffuse_texname.empty()) {
+      out.albedo_map = texture(t.diffuse_texname);
+    }
+    if (!t.roughness_texname.empty()) {
+      out.roughness_map = texture(t.roughness_texname);
+      channel("map_Pr", t.roughness_texopt, 'g', "roughness");
+    }
+    if (!t.metallic_texname.empty()) {
+      out.metallic_map = texture(t.metallic_texname);
+      channel("map_Pm", t.metallic_texopt, 'b', "metallic");
+    }
   } else if (max3(ks) > 0.0f && max3(kd) == 0.0f) {
     // Phong exponent to roughness: sqrt(2 / (Ns + 2)).
     out.material = make_material(MaterialKind::Metal, ks, std::sqrt(2.0f / (t.shininess + 2.0f)), 1.0f, vec3(0.0f));
@@ -197,8 +332,68 @@ MeshMaterial map_mtl(const tinyobj::material_t& t, const fs::path& dir, const st
   } else {
     out.material = make_material(MaterialKind::Lambertian, kd, 0.0f, 1.0f, vec3(0.0f));
   }
-  if (!t.diffuse_texname.empty() && textured(out.material.kind)) {
-    out.albedo_map.image = (dir / t.diffuse_texname).lexically_normal().string();
+  if (!t.diffuse_texname.empty() && textured(out.material.kind)) out.albedo_map = texture(t.diffuse_texname);
+  if (!t.emissive_texname.empty() && out.material.kind != MaterialKind::Emissive) {
+    warn("map_Ke is not read: its Ke is black (no emission to texture)");
+  }
+
+  // Normal maps. wavetrace renders tangent-space normal maps, not height maps. norm is
+  // one; MTL's bump (map_Bump) is a height map, except in a material that writes the
+  // PBR keys, whose writers put the tangent-space normal map there (with -bm its
+  // strength) when they do not write norm.
+  const std::string* normal = nullptr;
+  const tinyobj::texture_option_t* normal_options = nullptr;
+  const char* normal_key = "norm";
+  if (!t.normal_texname.empty()) {
+    normal = &t.normal_texname;
+    normal_options = &t.normal_texopt;
+  }
+  if (!t.bump_texname.empty()) {
+    if (normal) {
+      warn("its bump map is not read: norm gives its normal map");
+    } else if (pbr) {
+      normal = &t.bump_texname;
+      normal_options = &t.bump_texopt;
+      normal_key = k.has("map_Bump") ? "map_Bump" : k.has("map_bump") ? "map_bump" : "bump";
+    } else {
+      warn("its bump map '" + t.bump_texname +
+           "' is a height map (the material writes no PBR key), which wavetrace does not render; a tangent-space "
+           "normal map is read from norm");
+    }
+  }
+  if (normal) {
+    if (out.material.kind != MaterialKind::Principled) {
+      warn(std::string(normal_key) + " is not read: an emitter is not shaded");
+    } else {
+      out.normal_map = texture(*normal);
+      const float bm = normal_options->bump_multiplier;
+      if (!(bm >= 0.0f && bm <= 1e3f)) fail(path, what + ": " + normal_key + " -bm must be in [0, 1000]");
+      out.normal_scale = bm;
+    }
+  }
+
+  // Alpha: MTL's dissolve is coverage, d times map_d (read from the image's A
+  // channel), so a ray passes a point with probability 1 - alpha (BLEND).
+  if (!t.alpha_texname.empty() || t.dissolve < 1.0f) {
+    out.alpha_mode = static_cast<uint32_t>(AlphaMode::Blend);
+    out.alpha_factor = t.dissolve;
+    if (!t.alpha_texname.empty()) {
+      out.alpha_map = texture(t.alpha_texname);
+      channel("map_d", t.alpha_texopt, 'm', "coverage");
+    } else if (t.dissolve == 0.0f) {
+      warn(std::string(k.has("d") ? "d 0" : "Tr 1") + ": wholly transparent, its triangles are never seen");
+    }
+  }
+
+  // Keys read and not rendered, one line each.
+  if (!t.specular_texname.empty()) warn("map_Ks is not read: wavetrace has no specular-colour texture");
+  if (!t.specular_highlight_texname.empty()) {
+    warn("map_Ns is not read: wavetrace has no texture of the specular exponent");
+  }
+  if (k.has("Ps")) warn("Ps (sheen) is not rendered");
+  if (!t.sheen_texname.empty()) warn("map_Ps (sheen) is not rendered");
+  if (k.has("anisor")) {
+    warn("anisor (anisotropy rotation) is not rendered: the anisotropy follows the surface's tangent");
   }
   return out;
 }
@@ -228,16 +423,27 @@ class MaterialLibraries : public tinyobj::MaterialReader {
       if (err) *err += error_ + "\n";
       return false;
     }
+    const size_t first = materials->size();
     std::istringstream in(text);
     tinyobj::LoadMtl(names, materials, &in, warn, err);
+    std::vector<MtlKeys> keys = mtl_keys(text, name);
+    if (keys.size() != materials->size() - first) {  // mtl_keys splits as LoadMtl does: not expected
+      if (error_.empty()) error_ = "mtllib " + name + ": its materials could not be matched to their keys";
+      return false;
+    }
+    keys_.resize(first);
+    for (MtlKeys& k : keys) keys_.push_back(std::move(k));
     return true;
   }
 
   const std::string& error() const { return error_; }
+  // By material index: the keys each material writes.
+  const std::vector<MtlKeys>& keys() const { return keys_; }
 
  private:
   fs::path dir_;
   std::string error_;
+  std::vector<MtlKeys> keys_;
 };
 
 // tinyobjloader reads a number it cannot parse (`v abc 0 0`) as 0, keeps NaN and the
@@ -379,7 +585,9 @@ void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) 
     fail(path, "malformed OBJ: " + line);
   }
 
-  for (const tinyobj::material_t& t : materials) mesh.materials.push_back(map_mtl(t, dir, path));
+  for (size_t i = 0; i < materials.size(); ++i) {
+    mesh.materials.push_back(map_mtl(materials[i], i < mtl.keys().size() ? mtl.keys()[i] : MtlKeys{}, dir, mesh));
+  }
   int64_t fallback = -1;
   // Faces before any usemtl (or with no MTL at all): white Lambertian, so that a
   // texture paired with the mesh shows as it is.
