@@ -704,10 +704,14 @@ TEST_F(MeshLoad, GltfMaterialsAreThePrincipledKindWithTheirFactors) {
       {R"({"pbrMetallicRoughness": {"baseColorFactor": [0.1, 0.2, 0.3, 1], "metallicFactor": 0.2, "roughnessFactor": 0.1},
            "doubleSided": true, "extensions": {"KHR_materials_ior": {"ior": 1.7}}})",
        MaterialKind::Principled, vec3(0.1f, 0.2f, 0.3f), vec3(0.0f), 1.7f, 0.2f, 0.1f, false},
-      {R"({"emissiveFactor": [1, 0.5, 0]})", MaterialKind::Emissive, vec3(0.0f), vec3(1.0f, 0.5f, 0.0f), 1.0f, 0.0f, 1.0f,
-       false},
-      {R"({"emissiveFactor": [1, 0.5, 0], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})",
+      {R"({"emissiveFactor": [1, 0.5, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}})",
+       MaterialKind::Emissive, vec3(0.0f), vec3(1.0f, 0.5f, 0.0f), 1.0f, 0.0f, 1.0f, false},
+      {R"({"emissiveFactor": [1, 0.5, 0], "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+           "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}})",
        MaterialKind::Emissive, vec3(0.0f), vec3(4.0f, 2.0f, 0.0f), 1.0f, 0.0f, 1.0f, false},
+      // A base that reflects: principled, and it emits too.
+      {R"({"emissiveFactor": [1, 0.5, 0], "pbrMetallicRoughness": {"metallicFactor": 0}})", MaterialKind::Principled,
+       vec3(1.0f), vec3(1.0f, 0.5f, 0.0f), 1.5f, 0.0f, 1.0f, true},
       // glTF's default: metallic 1, roughness 1, single-sided.
       {R"({})", MaterialKind::Principled, vec3(1.0f), vec3(0.0f), 1.5f, 1.0f, 1.0f, true},
   };
@@ -728,6 +732,67 @@ TEST_F(MeshLoad, GltfMaterialsAreThePrincipledKindWithTheirFactors) {
     EXPECT_FLOAT_EQ(mm.roughness, c.roughness) << c.material;
     EXPECT_EQ((got.flags & kMaterialOneSided) != 0, c.one_sided) << c.material;
     EXPECT_TRUE(got.flags & kMaterialCompensated);
+    EXPECT_EQ((got.flags & kMaterialEmits) != 0, c.emission.x > 0.0f) << c.material;
+  }
+}
+
+// KHR_materials_clearcoat, _transmission and _volume reach the material's layers;
+// a texture of each is read with its texCoord and KHR_texture_transform.
+TEST_F(MeshLoad, GltfCoatTransmissionAndVolumeReachTheMaterial) {
+  TestGltf g = quad();
+  g.material = R"({"extensions": {
+      "KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.3,
+        "clearcoatTexture": {"index": 0}, "clearcoatRoughnessTexture": {"index": 0},
+        "clearcoatNormalTexture": {"index": 1, "scale": 0.5}},
+      "KHR_materials_transmission": {"transmissionFactor": 0.9,
+        "transmissionTexture": {"index": 0, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}},
+      "KHR_materials_volume": {"thicknessFactor": 0.2, "attenuationDistance": 0.5, "attenuationColor": [0.9, 0.5, 0.1]},
+      "KHR_materials_ior": {"ior": 1.4}}}],
+    "textures": [{"source": 0}, {"source": 1}], "images": [{"uri": "coat.png"}, {"uri": "n.png"}], "samplers": [{})";
+  const MeshMaterial mm = load_mesh(write("layers.gltf", g.embedded())).materials.at(0);
+  EXPECT_EQ(mm.material.kind, MaterialKind::Principled);
+  EXPECT_FLOAT_EQ(mm.clearcoat, 0.8f);
+  EXPECT_FLOAT_EQ(mm.clearcoat_roughness, 0.3f);
+  EXPECT_EQ(mm.clearcoat_map.image, (folder_.root() / "coat.png").string());
+  EXPECT_EQ(mm.clearcoat_roughness_map.image, mm.clearcoat_map.image);
+  EXPECT_EQ(mm.clearcoat_normal_map.image, (folder_.root() / "n.png").string());
+  EXPECT_FLOAT_EQ(mm.clearcoat_normal_scale, 0.5f);
+  EXPECT_FLOAT_EQ(mm.transmission, 0.9f);
+  EXPECT_EQ(mm.transmission_map.image, mm.clearcoat_map.image);
+  EXPECT_FLOAT_EQ(mm.transmission_map.uv_scale.x, 2.0f);
+  EXPECT_FALSE(mm.thin);
+  EXPECT_FLOAT_EQ(mm.attenuation_distance, 0.5f);
+  expect_vec(mm.attenuation_color, vec3(0.9f, 0.5f, 0.1f));
+  EXPECT_FLOAT_EQ(mm.material.ior, 1.4f);
+  // No volume (thickness 0, the default): a thin wall.
+  g.material = R"({"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}})";
+  const MeshMaterial thin = load_mesh(write("thin.gltf", g.embedded())).materials.at(0);
+  EXPECT_TRUE(thin.thin);
+  EXPECT_FLOAT_EQ(thin.transmission, 1.0f);
+  EXPECT_FLOAT_EQ(thin.clearcoat, 0.0f);
+}
+
+TEST_F(MeshLoad, GltfLayerFieldsOutOfRangeAreRefused) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.5}}})",
+       "KHR_materials_clearcoat clearcoatFactor must be in [0, 1]"},
+      {R"({"extensions": {"KHR_materials_clearcoat": {"clearcoatRoughnessFactor": -0.1}}})",
+       "KHR_materials_clearcoat clearcoatRoughnessFactor must be in [0, 1]"},
+      {R"({"extensions": {"KHR_materials_clearcoat": {"clearcoatTexture": {"index": -2}}}})",
+       "KHR_materials_clearcoat clearcoatTexture index must be a whole number >= 0"},
+      {R"({"extensions": {"KHR_materials_transmission": {"transmissionFactor": "all"}}})",
+       "KHR_materials_transmission transmissionFactor must be in [0, 1]"},
+      {R"({"extensions": {"KHR_materials_volume": {"thicknessFactor": -1}}})",
+       "KHR_materials_volume thicknessFactor must be a number >= 0"},
+      {R"({"extensions": {"KHR_materials_volume": {"attenuationDistance": 0}}})",
+       "KHR_materials_volume attenuationDistance must be a number > 0"},
+      {R"({"extensions": {"KHR_materials_volume": {"attenuationColor": [1, 2, 0]}}})",
+       "KHR_materials_volume attenuationColor must be 3 numbers in [0, 1]"},
+  };
+  for (const auto& [material, message] : cases) {
+    TestGltf g = quad();
+    g.material = material;
+    expect_error(write("bad.gltf", g.embedded()), std::string("material 'material 0': ") + message);
   }
 }
 
