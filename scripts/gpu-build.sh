@@ -6,7 +6,7 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 export WAVETRACE_BUILD=${WAVETRACE_BUILD:-$root/build}
 bash "$root/scripts/build.sh"
 mkdir -p "$root/.gpu/bin"
-cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$root/.gpu/bin/"
+cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$WAVETRACE_BUILD/wavetrace-gltf-tiles" "$root/.gpu/bin/"
 # The shared libraries they load (OpenEXR's family, the C++ runtime it needs) beside
 # them in lib/, where their RPATH looks first; glibc itself is the GPU machine's, and
 # so is Open MPI (its mpirun and libmpi.so.40 must be one installation).

@@ -20,6 +20,11 @@ mkdir -p "$out"
 cd "$root"
 export WAVETRACE_ROOT="$root"
 
+# The glTF tiles, for the tests that read the generator's files (WAVETRACE_TILES).
+if [[ -x "$bin/wavetrace-gltf-tiles" ]] && "$bin/wavetrace-gltf-tiles" "$out/tiles" >/dev/null; then
+  export WAVETRACE_TILES="$out/tiles"
+fi
+
 passed=0 failed=0 skipped=0 broken=()
 for t in "$bin"/*_tests; do
   [[ -x "$t" ]] || continue
