@@ -772,6 +772,20 @@ TEST_F(MeshLoad, GltfCoatTransmissionAndVolumeReachTheMaterial) {
   EXPECT_FLOAT_EQ(thin.clearcoat, 0.0f);
 }
 
+TEST_F(MeshLoad, GltfSpecularColourAndTexturesReachTheMaterial) {
+  TestGltf g = quad();
+  g.material = R"({"extensions": {"KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1, 0.8, 2],
+      "specularTexture": {"index": 0}, "specularColorTexture": {"index": 1}}}}],
+    "textures": [{"source": 0}, {"source": 1}], "images": [{"uri": "s.png"}, {"uri": "c.png"}], "samplers": [{})";
+  TriangleMesh m = load_mesh(write("specular.gltf", g.embedded()));
+  const MeshMaterial& mm = m.materials.at(0);
+  EXPECT_FLOAT_EQ(mm.specular, 0.5f);
+  expect_vec(mm.specular_color, vec3(1.0f, 0.8f, 2.0f));
+  EXPECT_EQ(mm.specular_map.image, (folder_.root() / "s.png").string());
+  EXPECT_EQ(mm.specular_color_map.image, (folder_.root() / "c.png").string());
+  EXPECT_TRUE(m.warnings.empty()) << m.warnings.front();
+}
+
 TEST_F(MeshLoad, GltfLayerFieldsOutOfRangeAreRefused) {
   const std::pair<const char*, const char*> cases[] = {
       {R"({"extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 1.5}}})",
@@ -788,6 +802,8 @@ TEST_F(MeshLoad, GltfLayerFieldsOutOfRangeAreRefused) {
        "KHR_materials_volume attenuationDistance must be a number > 0"},
       {R"({"extensions": {"KHR_materials_volume": {"attenuationColor": [1, 2, 0]}}})",
        "KHR_materials_volume attenuationColor must be 3 numbers in [0, 1]"},
+      {R"({"extensions": {"KHR_materials_specular": {"specularColorFactor": [1, -1, 0]}}})",
+       "KHR_materials_specular specularColorFactor must be 3 numbers in [0, 1000]"},
   };
   for (const auto& [material, message] : cases) {
     TestGltf g = quad();

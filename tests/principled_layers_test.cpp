@@ -18,6 +18,11 @@ const char* const kCoated[] = {
     R"({"name": "m", "type": "principled", "albedo": [0.8, 0.2, 0.1], "roughness": 0.6, "clearcoat": 0.5, "clearcoat_roughness": 0.5, "metallic": 0.5})",
     R"({"name": "m", "type": "principled", "albedo": [0.8, 0.2, 0.1], "roughness": 0.3, "clearcoat": 1})",
 };
+// KHR_materials_specular's tinted f0 and its strength (alone, and with a thin wall).
+const char* const kTinted[] = {
+    R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0.4, "specular_color": [1, 0.6, 0.3], "specular": 0.7})",
+    R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0.5, "specular_color": [0.5, 1, 1], "transmission": 0.7})",
+};
 const char* const kThin[] = {
     R"({"name": "m", "type": "principled", "albedo": [0.9, 0.7, 0.5], "roughness": 0.3, "transmission": 1})",
     R"({"name": "m", "type": "principled", "albedo": [0.9, 0.7, 0.5], "roughness": 0.7, "transmission": 0.6, "metallic": 0.2})",
@@ -63,6 +68,13 @@ TEST(PrincipledLayers, ChiSquareOfEachLayer) {
     const Case c = material(json);
     for (double deg : kAngles) expect_fits(c, deg);
   }
+  for (const char* json : kTinted) {
+    const Case c = material(json);
+    for (double deg : {0.0, 60.0}) {
+      expect_fits(c, deg, true);
+      if (c.p.transmission > 0.0f) expect_fits(c, deg, false);
+    }
+  }
   for (const char* const* list : {kThin, kVolume}) {
     for (int i = 0; i < (list == kThin ? 3 : 2); ++i) {
       const Case c = material(list[i]);
@@ -101,6 +113,7 @@ TEST(PrincipledLayers, WrongSharesFail) {
 
 TEST(PrincipledLayers, SampleWeightIsEvalOverPdf) {
   std::vector<std::string> cases(std::begin(kCoated), std::end(kCoated));
+  cases.insert(cases.end(), std::begin(kTinted), std::end(kTinted));
   cases.insert(cases.end(), std::begin(kThin), std::end(kThin));
   cases.insert(cases.end(), std::begin(kVolume), std::end(kVolume));
   for (const std::string& json : cases) {
@@ -132,6 +145,7 @@ TEST(PrincipledLayers, SampleWeightIsEvalOverPdf) {
 // without Turquin's compensation, whose 1 / E(mu_o) is not reciprocal.
 TEST(PrincipledLayers, LayersAreReciprocal) {
   std::vector<std::string> cases(std::begin(kCoated), std::end(kCoated));
+  cases.insert(cases.end(), std::begin(kTinted), std::end(kTinted));
   cases.insert(cases.end(), std::begin(kThin), std::end(kThin));
   cases.push_back(R"({"name": "m", "type": "principled", "albedo": [0.9, 0.7, 0.5], "roughness": 0.3, "transmission": 1,
       "thin": false, "energy_compensation": false})");
@@ -196,6 +210,32 @@ TEST(PrincipledLayers, AWhiteWallAndAWhiteVolumeLoseNothing) {
         }
       }
     }
+  }
+}
+
+// A white base under a tinted specular layer returns everything in each channel: the
+// layer's albedo for the tinted f0 is the index's rescaled (principled.hpp), exact
+// for a smooth layer and within 1% for rough compensated ones; and no tint of f0 at
+// most 1 returns more than arrives.
+TEST(PrincipledLayers, ATintedSpecularLayerOverAWhiteBaseReturnsEverything) {
+  for (const std::string r : {"0", "0.3", "0.7", "1"}) {
+    const Case c = material(R"({"name": "m", "type": "principled", "specular_color": [1, 0.5, 0], "roughness": )" + r + "}");
+    for (double deg : {0.0, 45.0, 80.0}) {
+      const vec3 wo = incident(deg);
+      const BsdfAt b = at(c, wo);
+      vec3 sum(0.0f);
+      constexpr int n = 160000;
+      for (int i = 0; i < n; ++i) {
+        const BsdfSample s = sample_bsdf(b, wo, Rng::at(3, static_cast<uint32_t>(i), 0, 0));
+        if (s.lobe != 0u) sum += s.weight;
+      }
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(sum[k] / n, 1.0, 0.01) << label(c, deg) << " channel " << k;
+    }
+  }
+  const Case tinted = material(R"({"name": "m", "type": "principled", "specular_color": [1000, 0.5, 1], "roughness": 0.5})");
+  for (double deg : kAngles) {
+    const Furnace f = furnace(tinted, incident(deg));
+    EXPECT_LE(f.mean, 1.0 + 4.0 * f.error + 1e-3) << label(tinted, deg);
   }
 }
 

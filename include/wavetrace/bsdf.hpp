@@ -16,6 +16,7 @@
 #include "wavetrace/bsdfs/metal.hpp"
 #include "wavetrace/bsdfs/plastic.hpp"
 #include "wavetrace/bsdfs/principled.hpp"
+#include "wavetrace/geometry/alpha.hpp"
 #include "wavetrace/mutant.hpp"
 
 namespace wt {
@@ -36,6 +37,15 @@ WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const 
     return fminf(fmaxf(eval_texture(in.textures[texture], in.images, sp)[c], 0.0f), 1.0f);
   };
   if (b.p.transmission_texture >= 0) b.p.transmission *= channel(b.p.transmission_texture, 0);
+  if (b.p.specular_texture >= 0) {
+    b.p.specular *= fminf(fmaxf(texture_alpha(in.textures[b.p.specular_texture], in.images,
+                                              sp.has_uv ? sp.uv : sphere_uv(sp.n)),
+                                0.0f),
+                          1.0f);
+  }
+  if (b.p.specular_color_texture >= 0) {
+    b.p.specular_color *= eval_texture(in.textures[b.p.specular_color_texture], in.images, sp);
+  }
   if (!(b.p.clearcoat > 0.0f)) return;
   if (b.p.clearcoat_texture >= 0) b.p.clearcoat *= channel(b.p.clearcoat_texture, 0);
   if (b.p.coat_roughness_texture >= 0) {

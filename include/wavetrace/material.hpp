@@ -52,8 +52,13 @@ struct MaterialParams {
   int32_t metallic_texture = -1;
   int32_t metal_table = -1;
   // Principled: the strength of the dielectric's specular layer (glTF's
-  // KHR_materials_specular specularFactor; 0: the base alone, a Lambertian).
+  // KHR_materials_specular specularFactor, times specular_texture's alpha; 0: the
+  // base alone, a Lambertian) and the tint of its f0 (specularColorFactor, times
+  // specular_color_texture's colour).
   float specular = 1.0f;
+  int32_t specular_texture = -1;
+  vec3 specular_color{1.0f};
+  int32_t specular_color_texture = -1;
   // Principled: a clear coat (KHR_materials_clearcoat) of weight `clearcoat` (times
   // clearcoat_texture's red channel) and GGX alpha coat_alpha (its roughness
   // squared; the roughness times coat_roughness_texture's green channel), with a

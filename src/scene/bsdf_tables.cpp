@@ -272,12 +272,11 @@ void prepare_microfacet(const Material& m, MaterialParams& p, std::vector<float>
     case MaterialKind::Principled: {
       // Its glossy lobes are Schlick conductors' (principled.hpp), compensated by
       // the conductors' tables (metal_table); the base is weighed by the layer's.
-      p.metal_table = -1;
+      // (Read uncompensated too: a tinted specular layer's albedo is moved towards
+      // the conductors' single scattering at f0 = 1.)
       const bool compensate = (m.flags & kMaterialCompensated) != 0;
-      if (compensate) {
-        if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
-        p.metal_table = conductor_offsets[separable];
-      }
+      if (conductor_offsets[separable] < 0) conductor_offsets[separable] = append(conductor_energy_table(separable));
+      p.metal_table = conductor_offsets[separable];
       auto layer = [&](float ior) {
         const auto key = std::make_tuple(ior, separable, compensate);
         auto found = shared.principled.find(key);

@@ -1066,11 +1066,25 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   out.specular = unit(extension_number(g.extensions, "KHR_materials_specular", "specularFactor", 1.0),
                       "KHR_materials_specular specularFactor");
   auto specular = g.extensions.find("KHR_materials_specular");
-  if (specular != g.extensions.end() && specular->second.IsObject()) {
-    for (const char* field : {"specularTexture", "specularColorFactor", "specularColorTexture"}) {
-      if (specular->second.Has(field)) {
-        images.mesh.warnings.push_back(what + ": KHR_materials_specular " + field + " is not read");
-      }
+  if (specular != g.extensions.end() && specular->second.IsObject() && specular->second.Has("specularColorFactor")) {
+    const tinygltf::Value& c = specular->second.Get("specularColorFactor");
+    double rgb[3] = {-1.0, -1.0, -1.0};
+    if (c.IsArray() && c.ArrayLen() == 3) {
+      for (int i = 0; i < 3; ++i) rgb[i] = c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : -1.0;
+    }
+    for (double v : rgb) {
+      if (!(v >= 0.0 && v <= 1e3)) fail(path, what + ": KHR_materials_specular specularColorFactor must be 3 numbers in [0, 1000]");
+    }
+    out.specular_color = vec3(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
+  }
+  {
+    tinygltf::NormalTextureInfo info;
+    if (extension_texture(g.extensions, "KHR_materials_specular", "specularTexture", path, what, info)) {
+      out.specular_map = texture(info, "specular texture");
+    }
+    info = {};
+    if (extension_texture(g.extensions, "KHR_materials_specular", "specularColorTexture", path, what, info)) {
+      out.specular_color_map = texture(info, "specular colour texture");
     }
   }
   out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");

@@ -43,7 +43,11 @@ struct MeshMaterial {
   // map (both linear), the normal map's x and y scaled by normal_scale.
   float roughness = 1.0f, metallic = 0.0f;
   float anisotropy = 0.0f;  // in [0, 1] (MTL's aniso)
-  float specular = 1.0f;  // KHR_materials_specular's specularFactor
+  // KHR_materials_specular: specularFactor (times specular_map's A channel) and
+  // specularColorFactor (times specular_color_map, sRGB).
+  float specular = 1.0f;
+  vec3 specular_color{1.0f};
+  MeshTexture specular_map, specular_color_map;
   // The roughness (its G channel) and metallic (its B channel) textures: glTF's
   // metallicRoughnessTexture is both (one texture), MTL's map_Pr and map_Pm each one.
   MeshTexture roughness_map, metallic_map, normal_map;

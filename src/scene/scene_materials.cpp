@@ -40,7 +40,8 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
        "metallic_texture", "normal_texture", "normal_strength", "energy_compensation", "masking", "double_sided",
        "specular", "clearcoat", "clearcoat_roughness", "clearcoat_texture", "clearcoat_roughness_texture",
        "clearcoat_normal_texture", "clearcoat_normal_strength", "transmission", "transmission_texture", "thin",
-       "attenuation_color", "attenuation_distance", "emission", "emission_texture"},
+       "attenuation_color", "attenuation_distance", "emission", "emission_texture", "specular_texture",
+       "specular_color", "specular_color_texture"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -192,6 +193,14 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
     p.transmission_texture = texture("transmission_texture");
     if (p.transmission_texture >= 0 && !j.contains("transmission")) l.transmission = 1.0f;
     p.emission_texture = texture("emission_texture");
+    p.specular_texture = texture("specular_texture");
+    p.specular_color_texture = texture("specular_color_texture");
+    if (j.contains("specular_color")) p.specular_color = triple(j["specular_color"], path / "specular_color");
+    for (int c = 0; c < 3; ++c) {
+      if (!(p.specular_color[c] >= 0.0f && p.specular_color[c] <= 1e3f)) {
+        fail_at(path / "specular_color", "each component must be in [0, 1000]");
+      }
+    }
     if (p.emission_texture >= 0 && !(m.flags & kMaterialEmits)) {
       fail_at(path / "emission_texture", "scales the emission: give \"emission\" too");
     }

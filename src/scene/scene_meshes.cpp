@@ -123,6 +123,9 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         if (!mm.clearcoat_normal_map.empty()) p.coat_normal_texture = texture_of(mm.clearcoat_normal_map, false);
         if (!mm.transmission_map.empty()) p.transmission_texture = texture_of(mm.transmission_map, false);
         if (!mm.emission_map.empty()) p.emission_texture = texture_of(mm.emission_map, true);
+        p.specular_color = mm.specular_color;
+        if (!mm.specular_map.empty()) p.specular_texture = texture_of(mm.specular_map, false);
+        if (!mm.specular_color_map.empty()) p.specular_color_texture = texture_of(mm.specular_color_map, true);
         if (!mm.roughness_map.empty()) p.roughness_texture = texture_of(mm.roughness_map, false);
         if (!mm.metallic_map.empty()) {
           // glTF's one texture for both is looked up once (bsdf_at).

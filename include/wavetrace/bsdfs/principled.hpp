@@ -111,12 +111,50 @@ WT_HD WT_INLINE float layer_average(const BsdfAt& b, int32_t table, float f0, fl
   return strength * cosine_table(b.tables + table + kEnergySize * kEnergySize, table_roughness(g));
 }
 
-// The specular layer's E_s(mu) and average, times its strength.
-WT_HD WT_INLINE float principled_layer_albedo(const BsdfAt& b, const Ggx& g, float mu) {
-  return layer_albedo(b, b.p.table, principled_f0(b), b.p.specular, g, mu);
+// The dielectric's f0 per channel: the index's, tinted by the specular colour
+// (KHR_materials_specular's specularColorFactor), at most 1.
+WT_HD WT_INLINE vec3 principled_f0_rgb(const BsdfAt& b) {
+  return glm::min(vec3(principled_f0(b)) * b.p.specular_color, vec3(1.0f));
 }
-WT_HD WT_INLINE float principled_layer_average(const BsdfAt& b, const Ggx& g) {
-  return layer_average(b, b.p.table, principled_f0(b), b.p.specular, g);
+
+// A rough layer's albedo e (directional, or its average) at the index's f0, made
+// the tinted f0's per channel: its single scattering is linear in f0 and is the
+// conductors' e1 at f0 = 1, so it is moved along that line; the compensation's
+// lobe, which is not (its F_avg^2), is taken off at f0 and put back at f0'. `lost`:
+// (1 - e1) (1 - e1_avg), what the multiple-scattering lobe of scale 1 returns.
+WT_HD WT_INLINE vec3 principled_tinted(const BsdfAt& b, float e, float e1, float e1_avg, float lost) {
+  const float f0 = principled_f0(b);
+  const vec3 f0t = principled_f0_rgb(b);
+  auto multiple = [&](const vec3& f) {
+    if (!(b.flags & kMaterialCompensated)) return vec3(0.0f);
+    return conductor_multiple_scale(f + (vec3(1.0f) - f) * (1.0f / 21.0f), e1_avg) * lost;
+  };
+  const float single = e - multiple(vec3(f0)).x;
+  return vec3(single) + (f0t - vec3(f0)) * ((e1 - single) / fmaxf(1.0f - f0, 1e-6f)) + multiple(f0t);
+}
+
+// The specular layer's E_s(mu) and average per channel, times its strength: Schlick's
+// Fresnel of the tinted f0 where smooth, else the index's table, tinted where the
+// layer is.
+WT_HD WT_INLINE bool principled_untinted(const BsdfAt& b) {
+  return b.p.specular_color.x == 1.0f && b.p.specular_color.y == 1.0f && b.p.specular_color.z == 1.0f;
+}
+WT_HD WT_INLINE vec3 principled_layer_albedo(const BsdfAt& b, const Ggx& g, float mu) {
+  if (g.smooth() || b.p.table < 0) return b.p.specular * schlick_f0(mu, principled_f0_rgb(b));
+  const float e = layer_albedo(b, b.p.table, principled_f0(b), 1.0f, g, mu);
+  if (principled_untinted(b) || b.p.metal_table < 0) return vec3(b.p.specular * e);
+  const float* t = b.tables + b.p.metal_table;
+  const float r = table_roughness(g);
+  const float e1 = conductor_energy(t, r, mu), e1_avg = conductor_average_energy(t, r);
+  return b.p.specular * principled_tinted(b, e, e1, e1_avg, (1.0f - e1) * (1.0f - e1_avg));
+}
+WT_HD WT_INLINE vec3 principled_layer_average(const BsdfAt& b, const Ggx& g) {
+  const vec3 f0 = principled_f0_rgb(b);
+  if (g.smooth() || b.p.table < 0) return b.p.specular * (f0 + (vec3(1.0f) - f0) * (1.0f / 21.0f));
+  const float e = layer_average(b, b.p.table, principled_f0(b), 1.0f, g);
+  if (principled_untinted(b) || b.p.metal_table < 0) return vec3(b.p.specular * e);
+  const float e1_avg = conductor_average_energy(b.tables + b.p.metal_table, table_roughness(g));
+  return b.p.specular * principled_tinted(b, e, e1_avg, e1_avg, (1.0f - e1_avg) * (1.0f - e1_avg));
 }
 
 // The coat's c E_c(mu).
@@ -142,7 +180,8 @@ struct PrincipledLobes {
 
 WT_HD WT_INLINE PrincipledLobes principled_lobes(const BsdfAt& b, const Ggx& g, const Ggx& gc, float mu_o, float mu_oc) {
   const float m = b.p.metallic, t = b.p.transmission;
-  const float fd = principled_layer_albedo(b, g, mu_o);
+  const vec3 layer = principled_layer_albedo(b, g, mu_o);
+  const float fd = (layer.x + layer.y + layer.z) * (1.0f / 3.0f);
   const vec3 fm = schlick_f0(mu_o, b.albedo);
   const float mean = (b.albedo.x + b.albedo.y + b.albedo.z) * (1.0f / 3.0f);
   const float coat = b.p.clearcoat > 0.0f ? principled_coat_albedo(b, gc, mu_oc) : 0.0f;
@@ -162,19 +201,21 @@ WT_HD WT_INLINE PrincipledLobes principled_lobes(const BsdfAt& b, const Ggx& g, 
 // The thin wall's transmitted lobe (before the tint) for wo and the mirror image wm
 // of wi in the surface (both local, above): the layer's lobe weighed by 1 - s F_d,
 // and the multiple-scattering energy the layer's compensation leaves.
-WT_HD WT_INLINE float principled_thin_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const vec3& wm) {
+WT_HD WT_INLINE vec3 principled_thin_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const vec3& wm) {
   const vec3 h = glm::normalize(wo + wm);
-  const float f0 = principled_f0(b);
-  const float reflected = b.p.specular * schlick_f0(glm::dot(wo, h), vec3(f0)).x;
-  float f = (1.0f - reflected) * g.d(h) * g.g2(wo, wm) / (4.0f * wo.z);
+  const vec3 f0 = principled_f0_rgb(b);
+  const vec3 reflected = b.p.specular * schlick_f0(glm::dot(wo, h), f0);
+  vec3 f = (vec3(1.0f) - reflected) * (g.d(h) * g.g2(wo, wm) / (4.0f * wo.z));
   if ((b.flags & kMaterialCompensated) && b.p.metal_table >= 0) {
     const float* t = b.tables + b.p.metal_table;
     const float r = table_roughness(g);
     const float e = conductor_average_energy(t, r);
     if (1.0f - e > 1e-5f) {
       // All the multiple scattering of a white lobe, 1 / (1 - E_avg), less the layer's.
-      const float scale = 1.0f / (1.0f - e) - b.p.specular * conductor_multiple_scale(vec3(f0 + (1.0f - f0) / 21.0f), e).x;
-      f += fmaxf(scale, 0.0f) * (1.0f - conductor_energy(t, r, wo.z)) * (1.0f - conductor_energy(t, r, wm.z)) * wm.z / kPi;
+      const vec3 scale = vec3(1.0f / (1.0f - e)) -
+                         b.p.specular * conductor_multiple_scale(f0 + (vec3(1.0f) - f0) * (1.0f / 21.0f), e);
+      f += glm::max(scale, vec3(0.0f)) *
+           ((1.0f - conductor_energy(t, r, wo.z)) * (1.0f - conductor_energy(t, r, wm.z)) * wm.z / kPi);
     }
   }
   return f;
@@ -210,14 +251,15 @@ WT_HD WT_INLINE vec3 principled_eval_all(const BsdfAt& b, const vec3& wo_world, 
   const bool thick = principled_thick(b);
   const BsdfAt metal = principled_lobe(b, b.albedo);
   if (wi.z > 0.0f) {
-    const float layer = (1.0f - principled_layer_albedo(b, g, wo.z)) * (1.0f - principled_layer_albedo(b, g, wi.z)) /
-                        fmaxf(1.0f - principled_layer_average(b, g), 1e-6f);
-    f += b.albedo * (through * (1.0f - m) * (1.0f - t) * layer * wi.z / kPi);
+    const vec3 layer = (vec3(1.0f) - principled_layer_albedo(b, g, wo.z)) *
+                       (vec3(1.0f) - principled_layer_albedo(b, g, wi.z)) /
+                       glm::max(vec3(1.0f) - principled_layer_average(b, g), vec3(1e-6f));
+    f += b.albedo * layer * (through * (1.0f - m) * (1.0f - t) * wi.z / kPi);
     pdf += l.diffuse * wi.z / kPi;
     if (!g.smooth()) {
       const float dielectric_share = (1.0f - m) * b.p.specular * (thick ? 1.0f - t : 1.0f);
       if (dielectric_share > 0.0f) {
-        f += (through * dielectric_share) * conductor_eval_local(principled_lobe(b, vec3(principled_f0(b))), g, wo, wi);
+        f += (through * dielectric_share) * conductor_eval_local(principled_lobe(b, principled_f0_rgb(b)), g, wo, wi);
       }
       if (m > 0.0f) f += (through * m) * conductor_eval_local(metal, g, wo, wi);
       // The lobes' samplers differ only in the multiple-scattering lobe's share,
@@ -280,7 +322,7 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
       wi_world = fr.to_world(vec3(-wo.x, -wo.y, wo.z));
       if (!b.same_side(wi_world)) return no_sample();
       const vec3 mirror = ((1.0f - m) * b.p.specular * (thick ? 1.0f - t : 1.0f)) *
-                              schlick_f0(wo.z, vec3(principled_f0(b))) +
+                              schlick_f0(wo.z, principled_f0_rgb(b)) +
                           m * schlick_f0(wo.z, b.albedo);
       return BsdfSample{wi_world, mirror * (through(wi_world) / l.glossy), 0.0f, kLobeSpecular | kLobeReflection};
     }
@@ -293,7 +335,7 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
     if (g.smooth()) {
       // Straight through the thin wall, less what the layer reflects.
       wi_world = -wo_world;
-      const float passed = 1.0f - b.p.specular * schlick_f0(wo.z, vec3(principled_f0(b))).x;
+      const vec3 passed = vec3(1.0f) - b.p.specular * schlick_f0(wo.z, principled_f0_rgb(b));
       const vec3 weight = b.albedo * ((1.0f - m) * t * passed * through(wi_world) / l.transmit);
       return BsdfSample{wi_world, weight, 0.0f, kLobeSpecular | kLobeTransmission};
     }
