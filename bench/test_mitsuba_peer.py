@@ -462,8 +462,10 @@ class MeshTest(Base):
         faces = struct.unpack_from("<8I", body, 4 * 8 * 4)
         self.assertEqual(faces, (3, 0, 2, 1, 3, 1, 2, 3))
         self.assertNotIn("face_normals", plys[0])
-        b = self.bsdf_of(conv, plys[0])["bsdf"]
-        self.assertTrue(close(b["reflectance"]["value"], [0.4, 0.5, 0.6]))
+        # glTF materials are principled (one-sided: doubleSided defaults to false).
+        b = self.bsdf_of(conv, plys[0])
+        self.assertEqual(b["type"], "principled")
+        self.assertTrue(close(b["base_color"]["value"], [0.4, 0.5, 0.6]))
         self.assertEqual(self.bsdf_of(conv, plys[3])["bsdf"]["reflectance"]["value"], [0.5, 0.5, 0.5])
         conv = self.convert(doc, instancing=True)
         groups = self.shapes(conv, "shapegroup")
@@ -730,7 +732,11 @@ class TexturedMaterialTest(Base):
         self.assertEqual(flat["type"], "diffuse")                         # strength 0: no perturbation
         self.assertEqual(proc["type"], "twosided")                        # not mapped
         notes = " ".join(conv.notes)
-        for fragment in ("normal_strength 0.5 of 'l'", "normal_texture 'squares' of 'proc': a checker texture "
+        # The strength scales the map's x and y before Mitsuba normalises it.
+        self.assertEqual((l["normalmap"]["type"], l["normalmap"]["strength"]), ("wt_normal_scale", 0.5))
+        self.assertEqual(l["normalmap"]["texture"]["type"], "bitmap")
+        self.assertEqual(p["normalmap"]["type"], "bitmap")               # strength 1: the map itself
+        for fragment in ("normal_texture 'squares' of 'proc': a checker texture "
                          "used as a normal map does not map", "normal maps on spheres", "flip_invalid_normals",
                          "its y (green) the same way"):
             self.assertIn(fragment, notes)
@@ -762,7 +768,10 @@ class TexturedMaterialTest(Base):
         self.assertEqual(modes, ["repeat", "clamp", "mirror"])
         notes = " ".join(conv.notes)
         self.assertIn("wavetrace repeat u and clamp v", notes)            # the default: [repeat, clamp]
-        self.assertIn("image texture 'c': its uv_scale, uv_offset and uv_rotation are not converted", notes)
+        # uv_scale (2, 2) after the sphere's own turn: to_uv = scale x SPHERE_TO_UV.
+        c = self.bsdf_of(conv, self.shapes(conv, "sphere")[2])["reflectance"]
+        self.assertEqual(c["to_uv"]["__transform__"], mp.mat_mul(mp.mat_scale([2, 2, 1]), mp.SPHERE_TO_UV))
+        self.assertNotIn("not converted", notes)
 
 
 class ConductorPresetsTest(Base):
