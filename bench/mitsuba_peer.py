@@ -4,6 +4,8 @@ scene dicts, and rendered with Mitsuba's path tracer, timed as wavetrace's
 renders are (one warm-up render, then the median of 3).
 
     python3 bench/mitsuba_peer.py convert SCENE.json [--width W ...]   # the dict and the notes
+    python3 bench/mitsuba_peer.py regions SCENE.json --width W --height H -o REGIONS.json
+            # each placed glTF mesh's pixel boxes, for bench/peer_regions.py
     python3 bench/mitsuba_peer.py render SCENE.json --width W --height H --spp N --depth D
             [--roulette-depth R] [--seed S] [--mode symbolic|evaluated|both]
             [--variant cuda_ad_rgb] [-o OUT_PREFIX] [--json RESULTS.json]
@@ -36,7 +38,7 @@ import sys
 import tempfile
 import time
 
-CONVERTER_VERSION = 1
+CONVERTER_VERSION = 2
 
 # Every Mitsuba plugin type the converter can emit (scripts/peer-pack.sh keeps
 # these, and what they load, in the trimmed package).
@@ -46,9 +48,10 @@ EMITTED_PLUGINS = (
     "diffuse", "twosided", "conductor", "roughconductor", "dielectric", "plastic",
     "roughdielectric", "thindielectric", "roughplastic", "principled", "normalmap",
     "area", "constant", "envmap", "bitmap", "rgb",
+    "principledthin", "mask", "point", "spot", "directional", "volpath", "homogeneous", "constvolume",
 )
 # Python plugins registered by load_scene when a dict names them.
-PYTHON_PLUGINS = ("wt_checker", "wt_scale", "wt_roughness", "wt_null")
+PYTHON_PLUGINS = ("wt_checker", "wt_scale", "wt_roughness", "wt_null", "wt_channel", "wt_normal_scale")
 
 # Metal fuzz -> Beckmann roughness: equal mean-square slope of the half vector
 # at normal incidence. wavetrace's fuzzy mirror turns the reflection r into
@@ -589,70 +592,244 @@ def _node_matrix(node):
     return m
 
 
-def _gltf_material(doc, index, mesh_name, folder, notes):
+# glTF sampler codes (wrapS / wrapT, magFilter / minFilter) as wavetrace reads them.
+GLTF_WRAP = {10497: "repeat", 33071: "clamp", 33648: "mirror"}
+GLTF_NEAREST = 9728
+GLTF_LINEAR = 9729
+
+# Embedded images by MIME type: the file extension Mitsuba's bitmap reader needs.
+IMAGE_EXTENSIONS = {"image/png": ".png", "image/jpeg": ".jpg", "image/bmp": ".bmp", "image/gif": ".gif"}
+
+
+class MeshParts(list):
+    """A mesh file's parts, and its KHR_lights_punctual lights (dicts: kind,
+    matrix (the node's, in the file's coordinates), intensity, range, cone
+    angles)."""
+
+    def __init__(self, parts=(), lights=()):
+        super().__init__(parts)
+        self.lights = list(lights)
+
+
+def _uri_decode(uri):
+    return re.sub(r"%([0-9a-fA-F]{2})", lambda m: chr(int(m.group(1), 16)), uri)
+
+
+def _sniff_extension(data):
+    if data[:8] == b"\x89PNG\r\n\x1a\n":
+        return ".png"
+    if data[:3] == b"\xff\xd8\xff":
+        return ".jpg"
+    if data[:2] == b"BM":
+        return ".bmp"
+    return None
+
+
+def gltf_image_file(doc, buffers, path, index):
+    """The file of glTF image INDEX: beside the mesh file (a uri), or its bytes (a
+    GLB buffer view, a data URI) written once to the cache folder, named by
+    their hash (Mitsuba's bitmap reads files only)."""
+    image = doc["images"][index]
+    uri = image.get("uri")
+    if uri is not None and not uri.startswith("data:"):
+        return os.path.normpath(os.path.join(os.path.dirname(path), _uri_decode(uri)))
+    if uri is not None:
+        head, _, body = uri.partition(",")
+        mime = head[5:].split(";")[0]
+        data = base64.b64decode(body) if ";base64" in head else _uri_decode(body).encode("latin-1")
+    elif "bufferView" in image:
+        view = doc["bufferViews"][image["bufferView"]]
+        start = view.get("byteOffset", 0)
+        data = bytes(buffers[view["buffer"]][start:start + view["byteLength"]])
+        mime = image.get("mimeType", "")
+    else:
+        raise ConversionError("%s: image %d has neither a uri nor a buffer view" % (path, index))
+    if not data:
+        raise ConversionError("%s: image %d is empty" % (path, index))
+    ext = IMAGE_EXTENSIONS.get(mime) or _sniff_extension(data)
+    if ext is None:
+        raise ConversionError("%s: image %d: type '%s' is not one Mitsuba's bitmap reads" % (path, index, mime))
+    out = os.path.join(cache_dir(), "embedded-%s%s" % (hashlib.sha1(data).hexdigest()[:20], ext))
+    if not os.path.exists(out):
+        _write_atomic(out, data)
+    return out
+
+
+def _gltf_texture(doc, buffers, path, info, colorspace, name):
+    """A material's textureInfo as an inline wavetrace image texture (what the
+    scene file's `textures` hold), with the glTF sampler's wrap and filters and
+    KHR_texture_transform's uv_offset / uv_scale / uv_rotation; and the
+    TEXCOORD set it reads."""
+    tex = doc["textures"][info["index"]]
+    if "source" not in tex:
+        raise ConversionError("%s: %s: the texture has no source image (only an extension's)" % (path, name))
+    t = {"name": name, "type": "image", "file": gltf_image_file(doc, buffers, path, tex["source"]),
+         "colorspace": colorspace, "wrap": ["repeat", "repeat"], "filter": "trilinear", "magnify": "bilinear"}
+    if "sampler" in tex:
+        s = doc["samplers"][tex["sampler"]]
+        t["wrap"] = [GLTF_WRAP.get(s.get("wrapS", 10497), "repeat"), GLTF_WRAP.get(s.get("wrapT", 10497), "repeat")]
+        t["magnify"] = "nearest" if s.get("magFilter") == GLTF_NEAREST else "bilinear"
+        t["filter"] = {GLTF_NEAREST: "nearest", GLTF_LINEAR: "bilinear"}.get(s.get("minFilter"), "trilinear")
+    uv_set = info.get("texCoord", 0)
+    x = info.get("extensions", {}).get("KHR_texture_transform")
+    if x is not None:
+        t["uv_offset"] = list(x.get("offset", [0, 0]))
+        t["uv_scale"] = list(x.get("scale", [1, 1]))
+        t["uv_rotation"] = float(x.get("rotation", 0.0))
+        uv_set = x.get("texCoord", uv_set)
+    return t, uv_set
+
+
+def _gltf_material(doc, buffers, index, mesh_name, path, notes):
+    """glTF material INDEX as wavetrace maps it (src/scene/mesh_load.cpp, map_gltf):
+    a `principled` material dict of the scene file's keys, its textures inline;
+    an `emissive` one where the material emits and nothing else reflects. Also
+    the TEXCOORD set its textures read (the first texture's, as wavetrace's)."""
     if index is None:
-        return {"type": "metal", "albedo": [1, 1, 1], "fuzz": 1.0, "name": "%s/default" % mesh_name}
-    g = doc["materials"][index]
+        # The specification's default material: every property at its default.
+        g = {"name": "default"}
+    else:
+        g = doc["materials"][index]
     name = "%s/%s" % (mesh_name, g.get("name", "material %d" % index))
     pbr = g.get("pbrMetallicRoughness", {})
-    base = list(pbr.get("baseColorFactor", [1, 1, 1, 1]))[:3]
-    metallic = pbr.get("metallicFactor", 1.0)
-    rough = pbr.get("roughnessFactor", 1.0)
-    emissive = g.get("emissiveFactor", [0, 0, 0])
-    if any(emissive):
-        m = {"type": "emissive", "emission": list(emissive)}
-    elif metallic >= 0.5:
-        m = {"type": "metal", "albedo": base, "fuzz": rough}
-    elif rough < 0.5:
-        m = {"type": "coated", "albedo": base, "ior": 1.5}
+    ext = g.get("extensions", {})
+    factor = list(pbr.get("baseColorFactor", [1, 1, 1, 1]))
+    base = factor[:3]
+    strength = ext.get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+    emission = [float(e) * float(strength) for e in g.get("emissiveFactor", [0, 0, 0])]
+    transmission = float(ext.get("KHR_materials_transmission", {}).get("transmissionFactor", 0.0))
+    coat = ext.get("KHR_materials_clearcoat", {})
+    clearcoat = float(coat.get("clearcoatFactor", 0.0))
+    sets = []
+
+    def texture(info, colorspace, slot):
+        t, s = _gltf_texture(doc, buffers, path, info, colorspace, "%s %s" % (name, slot))
+        sets.append(s)
+        return t
+
+    alpha_mode = g.get("alphaMode", "OPAQUE")
+    alpha = None
+    if alpha_mode in ("MASK", "BLEND"):
+        textured = "baseColorTexture" in pbr
+        cutoff = float(g.get("alphaCutoff", 0.5)) if alpha_mode == "MASK" else None
+        a = float(factor[3])
+        if textured or (a < cutoff if cutoff is not None else a < 1.0):
+            alpha = {"mode": alpha_mode.lower(), "factor": a, "cutoff": cutoff}
+    reflects = any(base) or "baseColorTexture" in pbr or transmission != 0 or clearcoat != 0
+    if any(emission) and not reflects:
+        # An emitter alone (its 4% specular layer left out, as wavetrace does).
+        m = {"type": "emissive", "emission": emission, "name": name}
+        if "emissiveTexture" in g:
+            m["emission_texture"] = texture(g["emissiveTexture"], "srgb", "emissive texture")
     else:
-        m = {"type": "lambertian", "albedo": base}
-    tex = pbr.get("baseColorTexture")
-    if tex is not None and m["type"] in ("lambertian", "metal", "coated"):
-        image = doc["images"][doc["textures"][tex["index"]]["source"]]
-        if "uri" not in image or image["uri"].startswith("data:"):
-            raise ConversionError("%s: embedded glTF images are not supported (as in wavetrace)" % mesh_name)
-        m["__image__"] = {"file": os.path.join(folder, image["uri"]), "colorspace": "srgb"}
-    m["name"] = name
-    return m
+        ior = float(ext.get("KHR_materials_ior", {}).get("ior", 1.5))
+        m = {"type": "principled", "name": name, "albedo": base,
+             "metallic": float(pbr.get("metallicFactor", 1.0)), "roughness": float(pbr.get("roughnessFactor", 1.0)),
+             "ior": 1e4 if ior == 0 else ior,     # ior 0: f0 = 1, wavetrace's stand-in index
+             "specular": float(ext.get("KHR_materials_specular", {}).get("specularFactor", 1.0)),
+             "double_sided": bool(g.get("doubleSided", False))}
+        spec = ext.get("KHR_materials_specular", {})
+        for field in ("specularTexture", "specularColorFactor", "specularColorTexture"):
+            if field in spec:
+                notes.add("material '%s': KHR_materials_specular %s is not read (by wavetrace either)" % (name, field))
+        if any(emission):
+            m["emission"] = emission
+            if "emissiveTexture" in g:
+                m["emission_texture"] = texture(g["emissiveTexture"], "srgb", "emissive texture")
+        if clearcoat:
+            m["clearcoat"] = clearcoat
+            m["clearcoat_roughness"] = float(coat.get("clearcoatRoughnessFactor", 0.0))
+            for field, key in (("clearcoatTexture", "clearcoat_texture"),
+                               ("clearcoatRoughnessTexture", "clearcoat_roughness_texture"),
+                               ("clearcoatNormalTexture", "clearcoat_normal_texture")):
+                if field in coat:
+                    m[key] = texture(coat[field], "linear", field)
+        if transmission:
+            m["transmission"] = transmission
+            tt = ext.get("KHR_materials_transmission", {}).get("transmissionTexture")
+            if tt is not None:
+                m["transmission_texture"] = texture(tt, "linear", "transmission texture")
+        volume = ext.get("KHR_materials_volume", {})
+        if float(volume.get("thicknessFactor", 0.0)) > 0:
+            m["thin"] = False
+            if "attenuationDistance" in volume:
+                m["attenuation_distance"] = float(volume["attenuationDistance"])
+                m["attenuation_color"] = list(volume.get("attenuationColor", [1, 1, 1]))
+        if "baseColorTexture" in pbr:
+            m["texture"] = texture(pbr["baseColorTexture"], "srgb", "base colour texture")
+        if "metallicRoughnessTexture" in pbr:
+            t = texture(pbr["metallicRoughnessTexture"], "linear", "metallic-roughness texture")
+            m["roughness_texture"] = m["metallic_texture"] = t
+        if "normalTexture" in g:
+            m["normal_texture"] = texture(g["normalTexture"], "linear", "normal texture")
+            m["normal_strength"] = float(g["normalTexture"].get("scale", 1.0))
+        if "occlusionTexture" in g:
+            notes.add("glTF occlusionTexture: read and not applied, by wavetrace and the peer alike (paths find the "
+                      "occlusion)")
+    if alpha is not None:
+        if "baseColorTexture" in pbr:
+            alpha["texture"] = texture(pbr["baseColorTexture"], "linear", "base colour texture's alpha")
+        m["__alpha__"] = alpha
+    return m, (sets[0] if sets else 0)
+
+
+def _spot_cones(light):
+    spot = light.get("spot", {})
+    return float(spot.get("innerConeAngle", 0.0)), float(spot.get("outerConeAngle", math.pi / 4))
 
 
 def read_gltf(path, mesh_name, notes):
     """glTF / GLB: Mitsuba 3 reads neither, so each primitive (with the node
-    transforms applied, as wavetrace applies them) is written to a binary PLY."""
+    transforms applied, as wavetrace applies them) is written to a binary PLY.
+    The nodes' KHR_lights_punctual lights come back with the parts."""
     notes.add("glTF/GLB meshes: Mitsuba 3 has no glTF loader; each primitive was written to a PLY file "
               "(node transforms applied, as wavetrace does)")
     doc, buffers = _gltf_load(path)
-    folder = os.path.dirname(path)
     scenes = doc.get("scenes")
     if scenes:
         roots = scenes[doc.get("scene", 0)].get("nodes", [])
         todo = [(r, mat_identity()) for r in roots]
     else:
-        todo = [(i, mat_identity()) for i, n in enumerate(doc.get("nodes", [])) if "mesh" in n]
-        if not todo:
-            todo = None
+        todo = None
     placed = []   # (mesh index, matrix)
+    lights = []
     if todo is None:
         placed = [(i, mat_identity()) for i in range(len(doc.get("meshes", [])))]
     else:
         while todo:
+            # Depth first in the file's order, as wavetrace walks the nodes.
             i, parent = todo.pop(0)
             node = doc["nodes"][i]
             m = mat_mul(parent, _node_matrix(node))
             if "mesh" in node:
                 placed.append((node["mesh"], m))
-            todo += [(c, m) for c in node.get("children", [])]
+            punctual = node.get("extensions", {}).get("KHR_lights_punctual")
+            if punctual is not None:
+                g = doc["extensions"]["KHR_lights_punctual"]["lights"][punctual["light"]]
+                colour = g.get("color", [1, 1, 1])
+                light = {"kind": g["type"], "matrix": m, "name": g.get("name", ""),
+                         "intensity": [float(c) * float(g.get("intensity", 1.0)) for c in colour],
+                         "range": float(g.get("range", 0.0)) if g["type"] != "directional" else 0.0}
+                if g["type"] == "spot":
+                    light["inner"], light["outer"] = _spot_cones(g)
+                elif g["type"] not in ("point", "directional"):
+                    raise ConversionError("%s: light type '%s' is not point, spot or directional" % (path, g["type"]))
+                lights.append(light)
+            todo = [(c, m) for c in node.get("children", [])] + todo
+    materials = {}
     prims = [(mi_, m, p) for mi_, m in placed for p in doc["meshes"][mi_]["primitives"]]
     every_normal = all("NORMAL" in p["attributes"] for _, _, p in prims)
-    every_uv = all("TEXCOORD_0" in p["attributes"] for _, _, p in prims)
-    parts = []
+    parts = MeshParts(lights=lights)
     for k, (mesh_index, m, prim) in enumerate(prims):
         if prim.get("mode", 4) != 4:
             raise ConversionError("%s: a primitive that is not TRIANGLES" % path)
-        material = _gltf_material(doc, prim.get("material"), mesh_name, folder, notes)
+        key = prim.get("material")
+        if key not in materials:
+            materials[key] = _gltf_material(doc, buffers, key, mesh_name, path, notes)
+        material, uv_set = materials[key]
+        uv_name = "TEXCOORD_%d" % uv_set
         out = os.path.join(cache_dir(), "%s-%s.ply" % (os.path.splitext(os.path.basename(path))[0],
-                                                       _source_key(path, k)))
+                                                       _source_key(path, k, uv_set)))
         pos = _gltf_accessor(doc, buffers, prim["attributes"]["POSITION"])
         if "indices" in prim:
             ind = array.array("I", _gltf_accessor(doc, buffers, prim["indices"]))
@@ -663,7 +840,8 @@ def read_gltf(path, mesh_name, notes):
             for i in range(0, len(pos), 3):
                 p2[i:i + 3] = array.array("f", mat_point(m, pos[i:i + 3]))
             pos = p2
-        area_of = _area_function(pos, ind) if material["type"] == "emissive" else None
+        emits = material["type"] == "emissive" or any(material.get("emission", [0]))
+        area_of = _area_function(pos, ind) if emits else None
         if not os.path.exists(out):
             nrm = uv = None
             if every_normal:
@@ -677,12 +855,13 @@ def read_gltf(path, mesh_name, notes):
                         ln = math.sqrt(sum(c * c for c in w)) or 1.0
                         n2[i:i + 3] = array.array("f", [c / ln for c in w])
                     nrm = n2
-            if every_uv:
+            if uv_name in prim["attributes"]:
                 # glTF's v = 0 is the image's top row, where Mitsuba's bitmap and
                 # wavetrace's mesh UVs have v = 0 as well: written as it is. (OBJ
                 # files go to Mitsuba as they are; its reader and wavetrace's both
-                # read OBJ's v as 1 - v.)
-                uv = _gltf_accessor(doc, buffers, prim["attributes"]["TEXCOORD_0"])
+                # read OBJ's v as 1 - v.) The set is the one the material's
+                # textures read: a PLY holds one.
+                uv = _gltf_accessor(doc, buffers, prim["attributes"][uv_name])
             write_ply(out, pos, nrm, uv, ind)
         parts.append(MeshPart("ply", out, material, every_normal, _bounds(pos), area_of))
     if not parts:
@@ -779,6 +958,8 @@ class Converter:
         self.python_plugins = set()
         self.emitters = []      # (dict, wavetrace samples it, power)
         self.bounds = None      # scene bounding box (lo, hi)
+        self.punctuals = []     # (dict, power or None for directional, mean intensity)
+        self.needs_volpath = False
         self._bsdf_ids = {}
         self._counter = 0
 
@@ -843,7 +1024,7 @@ class Converter:
     def texture(self, name, albedo, on_sphere, to_object):
         """The reflectance: albedo times the named texture. to_object: the
         shape's world -> object matrix (for checker)."""
-        t = self.textures.get(name)
+        t = name if isinstance(name, dict) else self.textures.get(name)
         if t is None:
             raise ConversionError("unknown texture %s" % name)
         return self._texture(t, albedo, on_sphere, to_object)
@@ -895,16 +1076,33 @@ class Converter:
             self.notes.add("image textures: Mitsuba's bitmap wraps u and v alike (repeat), wavetrace %s u and %s "
                            "v: differs within half a texel of the %s" % (
                                wrap[0], wrap[1], "top and bottom rows" if wrap[0] == "repeat" else "edges"))
+        to_uv = SPHERE_TO_UV if on_sphere else mat_identity()
         if t is not None and any(k in t and t[k] != v for k, v in (("uv_scale", [1, 1]), ("uv_offset", [0, 0]),
                                                                     ("uv_rotation", 0))):
-            self.notes.add("image texture '%s': its uv_scale, uv_offset and uv_rotation are not converted "
-                           "(Mitsuba reads it at the surface's own UVs)" % t["name"])
+            # wavetrace's (and KHR_texture_transform's) uv' = offset + R (scale uv),
+            # R = [cos sin; -sin cos] (include/wavetrace/texture.hpp): the 2D
+            # affine map Mitsuba's bitmap applies through to_uv (its x, y and
+            # translation column), after the sphere's own turn where there is one.
+            sx, sy = (float(x) for x in t.get("uv_scale", [1, 1]))
+            ox, oy = (float(x) for x in t.get("uv_offset", [0, 0]))
+            c, s = math.cos(float(t.get("uv_rotation", 0))), math.sin(float(t.get("uv_rotation", 0)))
+            tr = [[c * sx, s * sy, 0.0, ox], [-s * sx, c * sy, 0.0, oy], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+            to_uv = mat_mul(tr, to_uv)
         if t is not None and t.get("filter", "trilinear") == "trilinear":
             self.notes.add("image texture '%s': wavetrace filters it trilinearly between mip levels where it is "
                            "minified, Mitsuba's bitmap bilinearly at full size (\"filter\": \"bilinear\" "
                            "compares like with like)" % t["name"])
-        if on_sphere:
-            d["to_uv"] = transform(SPHERE_TO_UV)
+        if t is not None and (t.get("magnify") == "nearest" or t.get("filter") == "nearest"):
+            # Mitsuba's bitmap has one filter for both ways.
+            d["filter_type"] = "nearest"
+            if t.get("magnify") != t.get("filter"):
+                self.notes.add("image texture '%s': nearest texels where wavetrace %s it and %s where it %s it; "
+                               "Mitsuba's bitmap filters one way, nearest, both ways" % (
+                                   t["name"], "magnifies" if t.get("magnify") == "nearest" else "minifies",
+                                   t.get("filter") if t.get("magnify") == "nearest" else t.get("magnify"),
+                                   "minifies" if t.get("magnify") == "nearest" else "magnifies"))
+        if not is_identity(to_uv):
+            d["to_uv"] = transform(to_uv)
         if not _is_white(albedo) and not self.allow_python:
             self.notes.add("image texture %s: without Python plugins, the albedo %s it is multiplied by "
                            "is dropped" % (os.path.basename(path), list(albedo)))
@@ -925,8 +1123,9 @@ class Converter:
     def object_space(self, m):
         """Whether one of the material's textures (its albedo's, its roughness's)
         is a function of the object-space point."""
-        for key in ("texture", "roughness_texture"):
-            t = self.textures.get(m.get(key, ""))
+        for key in ("texture", "roughness_texture", "metallic_texture"):
+            ref = m.get(key, "")
+            t = ref if isinstance(ref, dict) else self.textures.get(ref)
             if t is not None and t["type"] == "checker":
                 return True
         return False
@@ -936,6 +1135,8 @@ class Converter:
         name = m.get(key)
         if name is None:
             return None
+        if isinstance(name, dict):
+            return name     # a mesh file's own texture
         t = self.textures.get(name)
         if t is None:
             raise ConversionError("material '%s': unknown texture %s" % (m["name"], name))
@@ -957,7 +1158,7 @@ class Converter:
         t = self.texture_of(m, "roughness_texture")
         if t is None:
             return value
-        name = m["roughness_texture"]
+        name = t["name"]
         if takes_texture and self.allow_python and t["type"] in ("checker", "image"):
             self.python_plugins.add("wt_roughness")
             return {"type": "wt_roughness", "texture": self._texture(t, [1, 1, 1], on_sphere, to_object),
@@ -996,7 +1197,7 @@ class Converter:
         t = self.texture_of(m, "normal_texture")
         if t is None:
             return b
-        name = m["normal_texture"]
+        name = t["name"]
         strength = float(m.get("normal_strength", 1.0))
         if strength == 0:
             return b   # the unperturbed normal, in wavetrace too
@@ -1008,9 +1209,9 @@ class Converter:
         if t.get("colorspace", "srgb") != "linear":
             raise ConversionError("material '%s': normal_texture '%s' is read as sRGB; a normal map needs "
                                   "\"colorspace\": \"linear\" (wavetrace refuses it too)" % (m["name"], name))
-        if strength != 1:
-            self.notes.add("normal_strength %g of '%s': Mitsuba's normalmap has no strength; the map is used as it "
-                           "is (strength 1)" % (strength, m["name"]))
+        if strength != 1 and not self.allow_python:
+            self.notes.add("normal_strength %g of '%s': Mitsuba's normalmap has no strength, and without Python "
+                           "plugins the map is used as it is (strength 1)" % (strength, m["name"]))
         if on_sphere:
             self.notes.add("normal maps on spheres: both tangent frames run along the azimuth and up the image "
                            "(towards the +y pole), but Mitsuba's dp/du points the other way round (SPHERE_FRAME "
@@ -1031,6 +1232,13 @@ class Converter:
                        "surface; Mitsuba's shadow-terminator term is off (use_shadowing_function false: wavetrace "
                        "has none)")
         bitmap = self._image(self.file(t["file"]), "linear", [1, 1, 1], on_sphere, t)
+        if strength != 1 and self.allow_python:
+            # wavetrace (and glTF's normalTexture scale) scales the map's x and y
+            # by the strength before normalising; Mitsuba's normalmap reads
+            # 2 c - 1 and normalises: a texture of (strength (2 c - 1) + 1) / 2
+            # in x and y does it.
+            self.python_plugins.add("wt_normal_scale")
+            bitmap = {"type": "wt_normal_scale", "texture": bitmap, "strength": strength}
         return {"type": "normalmap", "normalmap": bitmap, "flip_invalid_normals": True,
                 "use_shadowing_function": False, "bsdf": b}
 
@@ -1073,6 +1281,8 @@ class Converter:
             b = self.glass(m, on_sphere, to_object)
         elif kind == "plastic":
             b = self.plastic(m, on_sphere, to_object)
+        elif kind == "principled":
+            b = self.principled(m, on_sphere, to_object)
         else:
             raise ConversionError("unknown material type %s" % kind)
         if kind in ("conductor", "plastic") or (not on_sphere and kind in ("lambertian", "metal", "coated")):
@@ -1080,7 +1290,191 @@ class Converter:
             # ray), and its conductors and plastics either side of any surface;
             # Mitsuba's BSDFs are one-sided unless wrapped.
             b = {"type": "twosided", "bsdf": b}
-        return self.normal_map(m, b, on_sphere)
+        return self.alpha(m, self.normal_map(m, b, on_sphere), on_sphere)
+
+    def channel(self, t, channel, scale, on_sphere, to_object, what, cutoff=None):
+        """SCALE times channel CHANNEL (0 red, 1 green, 2 blue) of texture T,
+        clamped to [0, 1] (and thresholded at CUTOFF where given): a wt_channel
+        texture; without Python plugins, SCALE alone (noted)."""
+        if not self.allow_python:
+            self.notes.add("%s: without Python plugins Mitsuba cannot read one channel of a texture; the factor %g "
+                           "alone is used" % (what, scale))
+            return float(scale)
+        self.python_plugins.add("wt_channel")
+        d = {"type": "wt_channel", "texture": self._texture(t, [1, 1, 1], on_sphere, to_object),
+             "channel": int(channel), "scale": float(scale)}
+        if cutoff is not None:
+            d["cutoff"] = float(cutoff)
+        return d
+
+    def principled(self, m, on_sphere, to_object):
+        """wavetrace's principled (glTF's metallic-roughness model,
+        include/wavetrace/bsdfs/principled.hpp) on Mitsuba's principled (Disney
+        2015), or principledthin where it passes light through a thin wall. What
+        the models do not share is noted, one line each."""
+        name = m["name"]
+        roughness = self.roughness_of(m)
+        anisotropy = float(m.get("anisotropy", 0.0))
+        metallic = float(m.get("metallic", 1.0 if "metallic_texture" in m else 0.0))
+        ior = float(m.get("ior", 1.5))
+        specular = float(m.get("specular", 1.0))
+        transmission = float(m.get("transmission", 1.0 if "transmission_texture" in m else 0.0))
+        thin = bool(m.get("thin", True))
+        clearcoat = float(m.get("clearcoat", 1.0 if "clearcoat_texture" in m else 0.0))
+        f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+        b = {"base_color": self.reflectance(m, on_sphere, to_object),
+             # Principled squares its roughness itself (alpha = roughness^2, over and
+             # times sqrt(1 - 0.9 anisotropic) along and across the tangent, as
+             # wavetrace's ggx_from_roughness): a roughness texture scales it linearly.
+             "roughness": self.textured(m, roughness, 1, on_sphere, to_object)}
+        if anisotropy > 0:
+            b["anisotropic"] = anisotropy
+        self._masking_note(m)
+        if roughness * roughness * math.sqrt(1.0 - 0.9 * anisotropy) < 0.001:
+            self.notes.add("principled below roughness 0.032: Mitsuba's principled keeps each alpha >= 0.001, where "
+                           "wavetrace's lobes are smaller, and mirrors (deltas) below alpha 1e-4")
+        self.notes.add("principled -> Mitsuba's principled: the metal is the same (Schlick from f0 = base colour on "
+                       "GGX); the dielectric's specular layer uses the exact Fresnel of the index where wavetrace's "
+                       "uses Schlick's, and its diffuse is Disney's (Schlick-weighted, with retro-reflection that "
+                       "grows with roughness), where wavetrace's is a Lambertian weighed by what the layer lets "
+                       "through, (1 - E_s(mu_o)) (1 - E_s(mu_i)) / (1 - E_s,avg)")
+        if m.get("energy_compensation", True):
+            self.notes.add("energy_compensation (the default, glTF materials' too): wavetrace gives principled's "
+                           "rough glossy lobes a Kulla-Conty lobe for what single scattering loses; Mitsuba's "
+                           "principled has none (the rougher, the darker the metal)")
+        tex = self.texture_of(m, "metallic_texture")
+        if tex is not None and metallic > 0:
+            metallic_value = self.channel(tex, 2, metallic, on_sphere, to_object,
+                                          "metallic_texture of '%s'" % name)
+        else:
+            metallic_value = metallic
+        tex = self.texture_of(m, "transmission_texture")
+        trans_value = transmission
+        if tex is not None and transmission > 0:
+            trans_value = self.channel(tex, 0, transmission, on_sphere, to_object,
+                                       "transmission_texture of '%s'" % name)
+        if transmission > 0 and thin:
+            # principledthin: Disney's thin surface, its specular transmission the
+            # layer's lobe passed straight through (roughness scaled by the index),
+            # tinted by the base colour, as wavetrace's thin wall is.
+            b.update({"type": "principledthin", "spec_trans": trans_value, "eta": ior})
+            self.notes.add("principled '%s', a thin wall that transmits: Mitsuba's principledthin (Disney's thin "
+                           "surface: the transmitted lobe's roughness scaled by (0.65 eta - 0.35), Fresnel exact, "
+                           "a Disney diffuse with no layer weighting); wavetrace mirrors the layer's own GGX lobe to "
+                           "the far side, weighed by 1 - s F_d, and loses nothing. principledthin has no metal and "
+                           "no clear coat%s" % (name, "" if not (metallic or clearcoat) else
+                                                ": metallic %g and clearcoat %g are dropped" % (metallic, clearcoat)))
+            if specular != 1:
+                self.notes.add("principled '%s': specular %g is not converted on a transmitting wall (eta = ior "
+                               "sets Mitsuba's layer)" % (name, specular))
+            return b
+        b["type"] = "principled"
+        if metallic_value != 0:
+            b["metallic"] = metallic_value
+        if transmission > 0:
+            # A volume: the share t refracts at the index (the exact Fresnel, as
+            # wavetrace's glass share), so eta is the index itself.
+            b["spec_trans"] = trans_value
+            b["eta"] = ior
+            self.notes.add("principled transmission into a volume -> principled spec_trans: Mitsuba tints each "
+                           "crossing by sqrt(base colour) (twice through a closed shape: the base colour), wavetrace "
+                           "each crossing by the base colour; both take the share t from the diffuse base and "
+                           "refract with the exact Fresnel of the index")
+            if specular != 1:
+                self.notes.add("principled '%s': specular %g is not converted where the material refracts (eta = "
+                               "ior sets Mitsuba's layer and the refraction alike)" % (name, specular))
+        else:
+            # Mitsuba's eta sets its layer's reflectance, f0 = ((eta - 1) / (eta +
+            # 1))^2 at normal incidence, as wavetrace's index sets F_d's f0. The
+            # layer's strength s (KHR_materials_specular) has no counterpart:
+            # the index whose f0 is s f0 gives the layer's normal-incidence
+            # reflectance (Mitsuba's still reaches 1 at grazing, wavetrace's s).
+            r = math.sqrt(max(specular, 0.0) * f0)
+            b["eta"] = max((1.0 + r) / (1.0 - r) if r < 1.0 else 1e4, 1.0 + 1e-4)
+            if specular != 1:
+                self.notes.add("principled '%s': specular %g -> eta %.5g, the index whose f0 is %g x %.4g (the "
+                               "layer's reflectance at normal incidence; Mitsuba's exact Fresnel still reaches 1 at "
+                               "grazing angles, wavetrace's s F_d reaches s)" % (name, specular, b["eta"], specular, f0))
+        if clearcoat > 0:
+            cr = float(m.get("clearcoat_roughness", 1.0 if "clearcoat_roughness_texture" in m else 0.0))
+            # Mitsuba's coat: clearcoat x 0.25 x Schlick(0.04) x GTR1(alpha = 0.1 -
+            # 0.099 gloss) x Smith G(alpha 0.25) / (4 mu_o): 4 c makes it a microfacet
+            # lobe of weight c, as wavetrace's coat is.
+            tex = self.texture_of(m, "clearcoat_texture")
+            b["clearcoat"] = (self.channel(tex, 0, 4.0 * clearcoat, on_sphere, to_object,
+                                           "clearcoat_texture of '%s'" % name) if tex is not None else 4.0 * clearcoat)
+            b["clearcoat_gloss"] = min(max((0.1 - cr * cr) / 0.099, 0.0), 1.0)
+            self.notes.add("clear coat -> principled clearcoat = 4 c (Mitsuba scales its coat by 0.25: 4 c makes it a "
+                           "lobe of weight c, f0 0.04, as wavetrace's), clearcoat_gloss = (0.1 - r^2) / 0.099 so that "
+                           "its GTR1 alpha is wavetrace's r^2 (clamped to [0.001, 0.1]); but GTR1's long tail is not "
+                           "GGX, its masking has a fixed alpha of 0.25, and Mitsuba adds the coat on top of the base "
+                           "where wavetrace weighs the base by min(1 - c E_c(mu_o), 1 - c E_c(mu_i))")
+            if cr * cr > 0.1:
+                self.notes.add("principled '%s': clearcoat_roughness %g (alpha %.3g) is rougher than Mitsuba's "
+                               "coat can be (alpha 0.1)" % (name, cr, cr * cr))
+            for key in ("clearcoat_roughness_texture", "clearcoat_normal_texture"):
+                if key in m:
+                    self.notes.add("principled '%s': its %s is not converted (Mitsuba's coat has one gloss and "
+                                   "follows the base's normal)" % (name, key))
+        if not m.get("double_sided", True):
+            # One-sided: wavetrace's back face reflects nothing, and so does Mitsuba's
+            # principled without spec_trans (its back-side Fresnel is spec_trans x the
+            # dielectric's, and its diffuse and coat are front-only): left bare.
+            return b
+        if transmission > 0:
+            # Mitsuba's twosided refuses transmitting BSDFs; principled with
+            # spec_trans is seen from both sides already, as wavetrace's is.
+            return b
+        return {"type": "twosided", "bsdf": b}
+
+    def alpha(self, m, b, on_sphere):
+        """B inside Mitsuba's mask where the material has glTF's alpha (MASK, BLEND):
+        the opacity the base colour's alpha times its factor, thresholded at the
+        cutoff for MASK (a wt_channel texture of the alpha channel, extracted from
+        the image when the scene is loaded: Mitsuba's bitmap drops alpha)."""
+        a = m.get("__alpha__")
+        if a is None:
+            return b
+        self.needs_volpath = True
+        if "texture" not in a:
+            # A constant alpha: MASK below its cutoff (wholly cut away), or BLEND.
+            opacity = 0.0 if a["mode"] == "mask" else a["factor"]
+        else:
+            t = dict(a["texture"])
+            bitmap = self._image(t["file"], "linear", [1, 1, 1], on_sphere, t)
+            bitmap["filename"] = {"__alpha_image__": {"file": t["file"]}}
+            if self.allow_python:
+                self.python_plugins.add("wt_channel")
+                opacity = {"type": "wt_channel", "texture": bitmap, "channel": 0, "scale": float(a["factor"])}
+                if a["mode"] == "mask":
+                    opacity["cutoff"] = float(a["cutoff"])
+            else:
+                opacity = bitmap
+                self.notes.add("alpha of '%s': without Python plugins the alpha is used as an opacity as it is (no "
+                               "factor%s)" % (m["name"], ", no cutoff" if a["mode"] == "mask" else ""))
+        self.notes.add("glTF alpha (MASK, BLEND) -> Mitsuba's mask (opacity = alpha x factor, 0 or 1 at the MASK "
+                       "cutoff; BLEND is a stochastic opacity in both); the integrator is volpath, whose shadow rays "
+                       "pass through masks as wavetrace's do (path's do not)")
+        return {"type": "mask", "opacity": opacity, "bsdf": b}
+
+    def medium_for(self, m):
+        """The interior medium of a principled volume that absorbs: Beer-Lambert's
+        sigma = -ln(colour) / distance per channel (KHR_materials_volume), a
+        homogeneous medium that only absorbs (albedo 0) in volpath."""
+        if m["type"] != "principled" or m.get("thin", True) or "attenuation_distance" not in m:
+            return None
+        if not float(m.get("transmission", 1.0 if "transmission_texture" in m else 0.0)) > 0:
+            return None
+        d = float(m["attenuation_distance"])
+        sigma = [-math.log(max(float(c), 1e-30)) / d for c in m.get("attenuation_color", [1, 1, 1])]
+        if not any(sigma):
+            return None
+        self.needs_volpath = True
+        self.notes.add("principled volume absorption -> a homogeneous medium inside the shape (sigma_t = -ln(colour) "
+                       "/ distance, albedo 0) under volpath: Beer-Lambert in both; Mitsuba samples the distance and "
+                       "ends absorbed paths (noisier), wavetrace multiplies by exp(-sigma t)")
+        return {"type": "homogeneous", "albedo": 0.0,
+                "sigma_t": {"type": "constvolume", "value": _rgb(sigma)}}
 
     def _compensation_note(self, m, how, mitsuba):
         """A note where wavetrace compensates the multiple scattering that the
@@ -1237,17 +1631,26 @@ class Converter:
             self._bsdf_ids[key] = ident
         return {"type": "ref", "id": self._bsdf_ids[key]}
 
-    def emitter_for(self, m, area):
-        """The area emitter of an emissive material (None for other kinds)."""
-        if m["type"] != "emissive":
+    @staticmethod
+    def emits(m):
+        """Whether the material emits: an emitter, or a principled material with an
+        emission (which reflects and emits)."""
+        if m["type"] == "emissive":
+            return any(float(x) for x in m["emission"])
+        return m["type"] == "principled" and any(float(x) for x in m.get("emission", [0, 0, 0]))
+
+    def emitter_for(self, m, area, on_sphere=False, to_object=None):
+        """The area emitter of a material that emits (None for others): its
+        emission, times its emission_texture where it has one (an emitter is
+        picked by its untextured emission x area in both)."""
+        if not self.emits(m):
             return None
         e = [float(x) for x in m["emission"]]
-        if not any(e):
-            return None
-        d = {"type": "area", "radiance": _rgb(e)}
+        radiance = _rgb(e)
         if "emission_texture" in m:
-            self.notes.add("emitter '%s': its emission_texture is not converted (Mitsuba's emits the untextured "
-                           "emission)" % m["name"])
+            radiance = self.texture(m["emission_texture"], e, on_sphere,
+                                    to_object if to_object is not None else mat_identity())
+        d = {"type": "area", "radiance": radiance}
         self.emitters.append((d, True, _mean3(e) * area))
         return d
 
@@ -1260,9 +1663,12 @@ class Converter:
             to_world = mat_mul(mat_mul(mat_translate(c), SPHERE_FRAME), mat_scale(r))
             shape = {"type": "sphere", "to_world": transform(to_world),
                      "bsdf": self.bsdf_ref(m, True, mat_translate([-x for x in c]))}
-            em = self.emitter_for(m, 4.0 * math.pi * r * r)
+            em = self.emitter_for(m, 4.0 * math.pi * r * r, True, mat_translate([-x for x in c]))
             if em is not None:
                 shape["emitter"] = em
+            medium = self.medium_for(m)
+            if medium is not None:
+                shape["interior"] = medium
             self.out[self._name("sphere")] = shape
             self._grow([x - r for x in c], [x + r for x in c])
 
@@ -1294,8 +1700,11 @@ class Converter:
                 corners = [[(lo, hi)[(k >> i) & 1][i] for i in range(3)] for k in range(8)]
                 world = [mat_point(matrix, c) for c in corners]
                 self._grow([min(w[i] for w in world) for i in range(3)], [max(w[i] for w in world) for i in range(3)])
-        if any(m["type"] == "emissive" for *_, mats in placements for m in mats):
+        if any(self.emits(m) for *_, mats in placements for m in mats):
             self.notes.add("emissive triangles emit on their front side only in Mitsuba (wavetrace: both sides)")
+        for inst, mesh, parts, matrix, mats in placements:
+            for light in getattr(parts, "lights", []):
+                self.punctual(light, matrix, mesh["name"])
         # Placements that can share one Mitsuba shapegroup: same mesh, same
         # materials, nothing that depends on the placement (object-space
         # textures, emitters: Mitsuba instances cannot carry area emitters).
@@ -1310,7 +1719,8 @@ class Converter:
                            "on the LLVM backend, against 0.1 s flattened)")
         groups = {}
         for k, (inst, mesh, parts, matrix, mats) in enumerate(placements):
-            shareable = self.instancing and not any(self.object_space(m) or m["type"] == "emissive" for m in mats)
+            shareable = self.instancing and not any(self.object_space(m) or self.emits(m) or
+                                                    self.medium_for(m) is not None for m in mats)
             key = (mesh["name"], tuple(m["name"] for m in mats)) if shareable else ("#", k)
             groups.setdefault(key, []).append(k)
         for key, members in groups.items():
@@ -1331,11 +1741,54 @@ class Converter:
             for p, m in zip(parts, mats):
                 shape = self._part_shape(p, None if is_identity(matrix) else matrix)
                 shape["bsdf"] = self.bsdf_ref(m, False, mat_inverse_affine(matrix))
-                if m["type"] == "emissive":
-                    em = self.emitter_for(m, p.area_of(matrix) if p.area_of else 0.0)
+                if self.emits(m):
+                    em = self.emitter_for(m, p.area_of(matrix) if p.area_of else 0.0, False,
+                                          mat_inverse_affine(matrix))
                     if em is not None:
                         shape["emitter"] = em
+                medium = self.medium_for(m)
+                if medium is not None:
+                    shape["interior"] = medium
                 self.out[self._name("mesh")] = shape
+
+    def punctual(self, light, placement, mesh_name):
+        """A mesh file's KHR_lights_punctual light, placed by the node's matrix and
+        the instance's: Mitsuba's point (intensity, W/sr), spot (intensity, cones)
+        or directional (irradiance, W/m^2), as wavetrace's PunctualLight."""
+        m = mat_mul(placement, light["matrix"])
+        pos = mat_point(m, [0.0, 0.0, 0.0])
+        tip = mat_point(m, [0.0, 0.0, -1.0])
+        d = [tip[i] - pos[i] for i in range(3)]
+        ln = math.sqrt(sum(x * x for x in d))
+        if ln == 0:
+            raise ConversionError("%s: a light's node transform collapses its direction" % mesh_name)
+        d = [x / ln for x in d]
+        intensity = [float(x) for x in light["intensity"]]
+        mean = _mean3(intensity)
+        what = "%s light '%s' of %s" % (light["kind"], light["name"], mesh_name)
+        if light["kind"] == "directional":
+            e = {"type": "directional", "direction": d, "irradiance": _rgb(intensity)}
+            power = None            # set by emitter_weights, from the scene's radius
+        elif light["kind"] == "point":
+            e = {"type": "point", "position": pos, "intensity": _rgb(intensity)}
+            power = 4.0 * mean
+        else:
+            inner, outer = light["inner"], light["outer"]
+            # Mitsuba's spot shines down its +z: a frame looking along d.
+            up = [0.0, 1.0, 0.0] if abs(d[1]) < 0.9 else [1.0, 0.0, 0.0]
+            e = {"type": "spot", "intensity": _rgb(intensity), "cutoff_angle": math.degrees(outer),
+                 "beam_width": math.degrees(inner),
+                 "to_world": transform(look_at_matrix(pos, [pos[i] + d[i] for i in range(3)], up))}
+            power = 2.0 * (1.0 - math.cos(outer)) * mean
+            self.notes.add("spot lights: Mitsuba's spot is full inside beam_width (glTF's innerConeAngle) and falls "
+                           "to 0 at cutoff_angle (outerConeAngle) linearly in the angle; wavetrace (the extension) "
+                           "by clamp((cos - cos_outer) / (cos_inner - cos_outer))^2, smaller in between")
+        if light["range"] > 0:
+            self.notes.add("%s: its range %g (a fade to 0 at that distance, (1 - (d / range)^4) in wavetrace) is "
+                           "not converted: Mitsuba's lights have none" % (what, light["range"]))
+        self.out[self._name("light")] = e
+        self.punctuals.append((e, power, mean))
+        self.emitters.append((e, "always", power))
 
     # -- sky ----------------------------------------------------------------
     def sky(self):
@@ -1409,13 +1862,24 @@ class Converter:
 
     def emitter_weights(self):
         """Which emitters light sampling picks, and how often: as wavetrace,
-        by power (mean emission x area); none where wavetrace samples none."""
-        sampled = [(d, p) for d, s, p in self.emitters if s and self.nee]
+        by power (mean emission x area); none where wavetrace samples none.
+        Punctual lights ("always") are reached by light sampling alone, nee or
+        not, a directional one weighed by its irradiance over the scene's
+        bounding disc, as wavetrace's PunctualLight::power."""
+        lo, hi = self.bounds if self.bounds else ([0.0] * 3, [0.0] * 3)
+        radius = 0.5 * math.sqrt(sum((b - a) ** 2 for a, b in zip(lo, hi)))
+        self.emitters = [(d, s, (_mean3(d["irradiance"]["value"]) * radius * radius
+                                 if p is None and d["type"] == "directional" else p)) for d, s, p in self.emitters]
+
+        def samples(s):
+            return s == "always" or (s and self.nee)
+
+        sampled = [(d, p) for d, s, p in self.emitters if samples(s)]
         if len(self.emitters) > 1 or any(not s for _, s, _ in self.emitters) or not self.nee:
             known = [p for _, p in sampled if p is not None]
             default = (sum(known) / len(known)) if known else 1.0
             for d, s, p in self.emitters:
-                d["sampling_weight"] = float((p if p is not None else default) if (s and self.nee) else 0.0)
+                d["sampling_weight"] = float((p if p is not None else default) if samples(s) else 0.0)
             if len(self.emitters) > 1 and any(p is None for _, p in sampled):
                 self.notes.add("environment sky's light-picking weight is the mean of the other emitters' "
                                "(wavetrace weighs it by its power)")
@@ -1443,6 +1907,12 @@ class Converter:
             if d["type"] in ("constant", "envmap"):
                 self.out["sky"] = d
         self.emitter_weights()
+        if self.needs_volpath:
+            # Shadow rays that pass through masks, and media inside volumes: volpath
+            # is path's integrator with both (the same depth and roulette).
+            self.out["integrator"]["type"] = "volpath"
+            self.notes.add("integrator: volpath (masks or absorbing volumes), which is path plus null surfaces in "
+                           "shadow rays and media")
         if "spheres" not in self.doc and "instances" not in self.doc:
             raise ConversionError("the scene has no spheres and no instances")
         return self.out
@@ -1473,6 +1943,109 @@ def convert(scene_path, **kw):
     settings = {"width": c.width, "height": c.height, "spp": c.spp, "depth": c.depth,
                 "roulette_depth": c.roulette_depth, "seed": c.seed, "nee": c.nee}
     return Conversion(scene, c.notes.list(), settings, c.python_plugins)
+
+
+# --------------------------------------------------------------------------
+# Tile regions: where each placed glTF mesh lands in the image
+# --------------------------------------------------------------------------
+
+class Pinhole:
+    """wavetrace's pinhole camera (include/wavetrace/camera.hpp): look_from,
+    look_at, up, vertical field of view; pixel (x, y) continuous, row 0 at the
+    top of the image."""
+
+    def __init__(self, cam, width, height):
+        def unit(a):
+            n = math.sqrt(sum(x * x for x in a))
+            return [x / n for x in a]
+
+        def cross(a, b):
+            return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+        self.origin = [float(x) for x in cam["look_from"]]
+        self.w = unit([float(a) - float(b) for a, b in zip(cam["look_from"], cam["look_at"])])
+        self.u = unit(cross([float(x) for x in cam.get("up", [0, 1, 0])], self.w))
+        self.v = cross(self.w, self.u)
+        self.half_h = math.tan(math.radians(float(cam.get("vfov", 40))) / 2)
+        self.half_w = self.half_h * width / height
+        self.width, self.height = width, height
+
+    def pixel(self, p):
+        """(x, y) of world point p, and its depth along the view (> 0: in front)."""
+        d = [p[i] - self.origin[i] for i in range(3)]
+        x = sum(d[i] * self.u[i] for i in range(3))
+        y = sum(d[i] * self.v[i] for i in range(3))
+        z = -sum(d[i] * self.w[i] for i in range(3))
+        return (0.5 + x / z / (2 * self.half_w)) * self.width, (0.5 - y / z / (2 * self.half_h)) * self.height, z
+
+
+# Every tile of tools/make_gltf_tiles.cpp fits this box before its placement.
+TILE_BOX = ([-0.5, 0.0, -0.5], [0.5, 1.0, 0.5])
+
+
+def tile_regions(scene_path, width, height, shrink=0.5):
+    """Each placed glTF mesh of the scene (a tile): its geometry's bounds (within
+    TILE_BOX) placed by the instance and projected through the scene's camera:
+    `bbox`, the pixels its box's corners span, and `inner`, that box shrunk
+    about the projected centre of the bounds to SHRINK of its width and height,
+    so that the ground between tiles weighs little in a tile's mean. The format
+    bench/peer_regions.py reads (--regions)."""
+    with open(scene_path, encoding="utf-8") as f:
+        doc = json.load(f)
+    folder = os.path.dirname(os.path.abspath(scene_path))
+    cam = Pinhole(doc["camera"], width, height)
+    meshes = {m["name"]: m for m in doc.get("meshes", [])}
+    notes = Notes()
+    bounds = {}
+    tiles = []
+    for inst in doc.get("instances", []):
+        mesh = meshes[inst["mesh"]]
+        if os.path.splitext(mesh["file"])[1].lower() not in (".glb", ".gltf"):
+            continue
+        if mesh["name"] not in bounds:
+            parts = read_mesh(os.path.normpath(os.path.join(folder, mesh["file"])), mesh["name"], notes)
+            lo = [max(min(p.bounds[0][i] for p in parts), TILE_BOX[0][i]) for i in range(3)]
+            hi = [min(max(p.bounds[1][i] for p in parts), TILE_BOX[1][i]) for i in range(3)]
+            bounds[mesh["name"]] = (lo, hi)
+        lo, hi = bounds[mesh["name"]]
+        m = instance_matrix(inst)
+        corners = [mat_point(m, [(lo, hi)[(k >> i) & 1][i] for i in range(3)]) for k in range(8)]
+        px = [cam.pixel(c) for c in corners]
+        if any(z <= 0 for _, _, z in px):
+            continue   # behind the camera, at least in part
+        cx, cy, _ = cam.pixel(mat_point(m, [0.5 * (a + b) for a, b in zip(lo, hi)]))
+        x0, x1 = min(p[0] for p in px), max(p[0] for p in px)
+        y0, y1 = min(p[1] for p in px), max(p[1] for p in px)
+        hx, hy = 0.5 * shrink * (x1 - x0), 0.5 * shrink * (y1 - y0)
+
+        def clip(v, hi_):
+            return int(min(max(v, 0), hi_))
+
+        bbox = [clip(math.floor(x0), width), clip(math.floor(y0), height),
+                clip(math.ceil(x1), width), clip(math.ceil(y1), height)]
+        inner = [clip(round(cx - hx), width), clip(round(cy - hy), height),
+                 clip(round(cx + hx), width), clip(round(cy + hy), height)]
+        if inner[2] <= inner[0] or inner[3] <= inner[1]:
+            continue   # outside the image
+        tiles.append({"name": mesh["name"], "file": mesh["file"], "center_px": [round(cx, 3), round(cy, 3)],
+                      "bbox": bbox, "inner": inner})
+    return {"scene": os.path.relpath(os.path.abspath(scene_path)), "width": width, "height": height,
+            "shrink": shrink, "tiles": tiles}
+
+
+def cmd_regions(args):
+    with open(args.scene, encoding="utf-8") as f:
+        r = json.load(f).get("render", {})
+    width, height = args.width or int(r.get("width", 640)), args.height or int(r.get("height", 360))
+    regions = tile_regions(args.scene, width, height, args.shrink)
+    text = json.dumps(regions, indent=1) + "\n"
+    if args.output in (None, "-"):
+        sys.stdout.write(text)
+    else:
+        with open(args.output, "w", encoding="utf-8") as f:
+            f.write(text)
+        print("%s: %d tiles at %d x %d" % (args.output, len(regions["tiles"]), width, height), file=sys.stderr)
+    return 0
 
 
 # --------------------------------------------------------------------------
@@ -1571,6 +2144,74 @@ def register_python_plugins(mi, dr, names):
 
         mi.register_texture("wt_roughness", lambda props: Roughness(props))
 
+    if "wt_channel" in names:
+        class Channel(mi.Texture):
+            """scale x clamp(one channel of a texture, 0, 1), and where a cutoff is
+            given 1 where that is >= cutoff, else 0 (glTF's metallic in blue,
+            transmission and clear coat in red, an alpha and its MASK cutoff)."""
+
+            def __init__(self, props):
+                mi.Texture.__init__(self, props)
+                self.nested = props.get("texture")
+                self.channel = int(props.get("channel"))
+                self.scale = props.get("scale")
+                self.cutoff = props.get("cutoff", -1.0)
+
+            def eval_1(self, si, active=True):
+                v = self.scale * dr.clip(self.nested.eval(si, active)[self.channel], 0.0, 1.0)
+                if self.cutoff >= 0.0:
+                    v = dr.select(v >= self.cutoff, 1.0, 0.0)
+                return mi.Float(v)
+
+            def eval(self, si, active=True):
+                return mi.Color3f(self.eval_1(si, active))
+
+            def mean(self):
+                return self.scale * min(max(self.nested.mean(), 0.0), 1.0)
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceChannel[channel=%d, scale=%g, cutoff=%g]" % (self.channel, self.scale, self.cutoff)
+
+        mi.register_texture("wt_channel", lambda props: Channel(props))
+
+    if "wt_normal_scale" in names:
+        class NormalScale(mi.Texture):
+            """A normal map with its x and y scaled by a strength (glTF's
+            normalTexture scale), still encoded as c = (n + 1) / 2 for Mitsuba's
+            normalmap, which normalises 2 c - 1."""
+
+            def __init__(self, props):
+                mi.Texture.__init__(self, props)
+                self.nested = props.get("texture")
+                self.strength = props.get("strength")
+
+            def eval(self, si, active=True):
+                c = self.nested.eval(si, active)
+                k = self.strength
+                return mi.Color3f(0.5 + k * (c[0] - 0.5), 0.5 + k * (c[1] - 0.5), c[2])
+
+            def eval_3(self, si, active=True):
+                # What Mitsuba's normalmap asks of its texture.
+                c = self.eval(si, active)
+                return mi.Vector3f(c[0], c[1], c[2])
+
+            def eval_1(self, si, active=True):
+                return dr.mean(self.eval(si, active))
+
+            def mean(self):
+                return self.nested.mean()
+
+            def traverse(self, callback):
+                pass
+
+            def to_string(self):
+                return "WavetraceNormalScale[strength=%g]" % self.strength
+
+        mi.register_texture("wt_normal_scale", lambda props: NormalScale(props))
+
     if "wt_null" in names:
         def zeros(cls):
             try:
@@ -1662,6 +2303,31 @@ def green_mean(mi, path, srgb):
     return _GREEN_MEANS[key]
 
 
+def alpha_image(mi, path):
+    """A PFM of an image's alpha channel (grey: the alpha in every channel), as
+    stored (alpha is linear in PNG and glTF); 1 where the image has none.
+    Mitsuba's bitmap texture keeps colour only, so an opacity reads this."""
+    key = _source_key(path, "alpha")
+    out = os.path.join(cache_dir(), "alpha-%s.pfm" % key)
+    if os.path.exists(out):
+        return out
+    import drjit as dr
+    bmp = mi.Bitmap(path)
+    bmp.set_srgb_gamma(False)
+    bmp = bmp.convert(mi.Bitmap.PixelFormat.RGBA, mi.Struct.Type.Float32, False)
+    w, h = bmp.size()
+    flat = array.array("f", dr.scalar.TensorXf(bmp).array)
+    rows = []
+    for y in range(h):
+        a = flat[4 * w * y + 3:4 * w * (y + 1):4]
+        row = array.array("f", bytes(12 * w))
+        for k in range(3):
+            row[k::3] = a
+        rows.append(row)
+    write_pfm(out, w, h, rows)
+    return out
+
+
 def environment_uv(mapping, e):
     """wavetrace's environment_uv (include/wavetrace/sky.hpp) for a unit direction."""
     x, y, z = e
@@ -1714,6 +2380,8 @@ def realize(mi, d):
         if "__green_mean__" in d:
             spec = d["__green_mean__"]
             return spec["scale"] * green_mean(mi, spec["file"], spec["srgb"]) ** spec["power"]
+        if "__alpha_image__" in d:
+            return alpha_image(mi, d["__alpha_image__"]["file"])
         out = {}
         for k, v in d.items():
             if k == "__envmap_image__":
@@ -1902,6 +2570,13 @@ def convert_kwargs(args):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("regions", help="each placed glTF mesh's pixel box (peer_regions.py --regions)")
+    p.add_argument("scene")
+    p.add_argument("--width", type=int)
+    p.add_argument("--height", type=int)
+    p.add_argument("--shrink", type=float, default=0.5,
+                   help="the inner box's share of the tile's projected box, about its centre (default 0.5)")
+    p.add_argument("-o", "--output", help="the regions file (default: stdout)")
     for name in ("convert", "render"):
         p = sub.add_parser(name)
         p.add_argument("scene")
@@ -1934,6 +2609,8 @@ def main(argv=None):
                            help="one more render with Dr.Jit's kernel history: kernel count and device seconds")
     args = ap.parse_args(argv)
     try:
+        if args.command == "regions":
+            return cmd_regions(args)
         return cmd_convert(args) if args.command == "convert" else cmd_render(args)
     except ConversionError as e:
         print("%s: %s" % (args.scene, e), file=sys.stderr)

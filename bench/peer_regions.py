@@ -6,7 +6,8 @@ image, and writes them side by side with their difference.
     peer_regions.py WAVETRACE.pfm PEER.exr [--regions REGIONS.json] [--png OUT.png]
                     [--json OUT.json] [--bound 0.01]
 
-Each sphere's (and the plane's) mean over its `inner` box (every pixel inside
+Each sphere's (and the plane's, or each glTF tile's: bench/mitsuba_peer.py
+regions) mean over its `inner` box (every pixel inside
 the silhouette), both images' channel means, and the relative difference
 (wavetrace - peer) / peer.
 The noise of that difference is estimated from the 2 x 2 blocks of the box: the
@@ -74,7 +75,8 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("wavetrace")
     p.add_argument("peer")
-    p.add_argument("--regions", help="tools/make_materials.py --regions output for this size")
+    p.add_argument("--regions", help="tools/make_materials.py --regions or bench/mitsuba_peer.py regions output "
+                                     "for this size")
     p.add_argument("--png")
     p.add_argument("--json")
     p.add_argument("--bound", type=float, default=0.01)
@@ -89,7 +91,10 @@ def main(argv=None):
         if (regions["width"], regions["height"]) != (wt.shape[1], wt.shape[0]):
             raise SystemExit("%s is for %d x %d, the images are %d x %d" % (
                 a.regions, regions["width"], regions["height"], wt.shape[1], wt.shape[0]))
-        boxes = [(s["material"], s["inner"]) for s in regions["spheres"] + regions.get("planes", [])]
+        # make_materials.py's spheres and planes (named by material), or
+        # mitsuba_peer.py regions' tiles (by mesh).
+        boxes = [(s.get("material") or s["name"], s["inner"])
+                 for s in regions.get("spheres", []) + regions.get("planes", []) + regions.get("tiles", [])]
     else:
         boxes = [("image", [0, 0, wt.shape[1], wt.shape[0]])]
     for name, (x0, y0, x1, y1) in boxes:

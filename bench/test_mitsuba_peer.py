@@ -462,14 +462,266 @@ class MeshTest(Base):
         faces = struct.unpack_from("<8I", body, 4 * 8 * 4)
         self.assertEqual(faces, (3, 0, 2, 1, 3, 1, 2, 3))
         self.assertNotIn("face_normals", plys[0])
-        b = self.bsdf_of(conv, plys[0])["bsdf"]
-        self.assertTrue(close(b["reflectance"]["value"], [0.4, 0.5, 0.6]))
+        # glTF materials are principled (one-sided: doubleSided defaults to false).
+        b = self.bsdf_of(conv, plys[0])
+        self.assertEqual(b["type"], "principled")
+        self.assertTrue(close(b["base_color"]["value"], [0.4, 0.5, 0.6]))
         self.assertEqual(self.bsdf_of(conv, plys[3])["bsdf"]["reflectance"]["value"], [0.5, 0.5, 0.5])
         conv = self.convert(doc, instancing=True)
         groups = self.shapes(conv, "shapegroup")
         inst = self.shapes(conv, "instance")
         self.assertEqual((len(groups), len(inst), len(self.shapes(conv, "ply"))), (1, 3, 1))
         self.assertTrue(close(mp.mat_point(inst[2]["to_world"]["__transform__"], [0, 0, 0]), [2, 0, 0]))
+
+
+# A few bytes that begin as a PNG does: the converter copies images, never decodes them.
+FAKE_PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(40))
+FAKE_JPEG = b"\xff\xd8\xff\xe0" + bytes(range(30, 70))
+
+
+def write_gltf_glb(path, doc, blobs):
+    """A GLB of DOC whose buffer 0 is BLOBS (bytes each) one after another, 4-byte
+    aligned, each a buffer view (returned in order as view indices)."""
+    body, views = b"", []
+    for blob in blobs:
+        views.append({"buffer": 0, "byteOffset": len(body), "byteLength": len(blob)})
+        body += blob + b"\0" * ((-len(blob)) % 4)
+    doc = dict(doc, buffers=[{"byteLength": len(body)}], bufferViews=doc.get("bufferViews", []) + views)
+    js = json.dumps(doc).encode()
+    js += b" " * ((-len(js)) % 4)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(js) + 8 + len(body)))
+        f.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
+        f.write(struct.pack("<II", len(body), 0x004E4942) + body)
+
+
+def quad_doc(materials, images, textures, samplers=(), nodes=None, lights=None, extra_views=0):
+    """A glTF of one quad (y = 0, facing +y) per material, its geometry in views
+    0-3 (the blobs of QUAD_BLOBS), and the given images / textures / samplers."""
+    prims = [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": k}
+             for k in range(len(materials))]
+    doc = {"asset": {"version": "2.0"}, "scene": 0,
+           "scenes": [{"nodes": list(range(len(nodes) if nodes else 1))}],
+           "nodes": nodes or [{"mesh": 0}], "meshes": [{"primitives": prims}], "materials": materials,
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+                         {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+                         {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+                         {"bufferView": 3, "componentType": 5125, "count": 6, "type": "SCALAR"}],
+           "images": images, "textures": textures, "samplers": list(samplers)}
+    if lights:
+        doc["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
+    return doc
+
+
+QUAD_BLOBS = [array.array("f", [-0.5, 0, 0.5, 0.5, 0, 0.5, 0.5, 0, -0.5, -0.5, 0, -0.5]).tobytes(),
+              array.array("f", [0, 1, 0] * 4).tobytes(),
+              array.array("f", [0, 0, 1, 0, 1, 1, 0, 1]).tobytes(),
+              array.array("I", [0, 1, 2, 0, 2, 3]).tobytes()]
+
+
+class GltfPrincipledTest(Base):
+    """glTF materials as wavetrace reads them (mesh_load.cpp, map_gltf) on Mitsuba's
+    principled and its wrappers."""
+
+    def scene(self, glb_doc, blobs=(), instances=None, **kw):
+        write_gltf_glb(os.path.join(self.tmp, "t.glb"), glb_doc, QUAD_BLOBS + list(blobs))
+        doc = scene_doc(spheres=[], meshes=[{"name": "t", "file": "t.glb"}],
+                        instances=instances or [{"mesh": "t"}], **kw)
+        return self.convert(doc)
+
+    def test_principled_factors_textures_wrappers_and_emitter(self):
+        # Images: 0 in the GLB's buffer (view 4), 1 a data URI.
+        images = [{"bufferView": 4, "mimeType": "image/png"},
+                  {"uri": "data:image/jpeg;base64," + __import__("base64").b64encode(FAKE_JPEG).decode()}]
+        textures = [{"source": 0, "sampler": 0}, {"source": 1}]
+        samplers = [{"wrapS": 33071, "wrapT": 33071, "magFilter": 9729, "minFilter": 9729}]
+        transform = {"KHR_texture_transform": {"offset": [0.25, 0.5], "scale": [2, 3], "rotation": 0.5}}
+        leaf = {"name": "leaf", "doubleSided": True, "alphaMode": "MASK", "alphaCutoff": 0.3,
+                "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.6, 0.7, 0.9], "metallicFactor": 0.25,
+                                         "roughnessFactor": 0.5,
+                                         "baseColorTexture": {"index": 0, "extensions": transform},
+                                         "metallicRoughnessTexture": {"index": 1}},
+                "normalTexture": {"index": 1, "scale": 0.5},
+                "emissiveFactor": [1, 0.5, 0.25],
+                "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4},
+                               "KHR_materials_ior": {"ior": 1.4}}}
+        conv = self.scene(quad_doc([leaf], images, textures, samplers), [FAKE_PNG],
+                          instances=[{"mesh": "t", "translate": [0, 0, 3]}])
+        shape = self.shapes(conv, "ply")[0]
+        mask = self.bsdf_of(conv, shape)
+        self.assertEqual(mask["type"], "mask")                            # alpha outermost
+        opacity = mask["opacity"]
+        self.assertEqual((opacity["type"], opacity["channel"], opacity["scale"], opacity["cutoff"]),
+                         ("wt_channel", 0, 0.9, 0.3))
+        self.assertEqual(opacity["texture"]["filename"]["__alpha_image__"]["file"],
+                         self.bsdf_of(conv, shape)["bsdf"]["bsdf"]["bsdf"]["base_color"]["texture"]["filename"])
+        nm = mask["bsdf"]
+        self.assertEqual((nm["type"], nm["normalmap"]["type"], nm["normalmap"]["strength"]),
+                         ("normalmap", "wt_normal_scale", 0.5))
+        self.assertFalse(nm["normalmap"]["texture"]["raw"] is False)
+        two = nm["bsdf"]
+        self.assertEqual(two["type"], "twosided")                         # doubleSided true
+        b = two["bsdf"]
+        self.assertEqual(b["type"], "principled")
+        rough = b["roughness"]                                             # green x factor, linear
+        self.assertEqual((rough["type"], rough["scale"], rough["power"]), ("wt_roughness", 0.5, 1.0))
+        self.assertEqual((b["metallic"]["type"], b["metallic"]["channel"], b["metallic"]["scale"]),
+                         ("wt_channel", 2, 0.25))                          # metallic: blue
+        self.assertAlmostEqual(b["eta"], 1.4, places=9)                   # f0 of the index itself (s = 1)
+        base = b["base_color"]
+        self.assertEqual((base["type"], base["r"], base["g"], base["b"]), ("wt_scale", 0.5, 0.6, 0.7))
+        bitmap = base["texture"]
+        self.assertEqual((bitmap["raw"], bitmap["wrap_mode"], bitmap["filter_type"]), (False, "clamp", "bilinear"))
+        c, s_ = math.cos(0.5), math.sin(0.5)
+        self.assertTrue(all(close(r1, r2, 1e-12) for r1, r2 in zip(bitmap["to_uv"]["__transform__"], [
+            [2 * c, 3 * s_, 0, 0.25], [-2 * s_, 3 * c, 0, 0.5], [0, 0, 1, 0], [0, 0, 0, 1]])))
+        # The emitter: emissiveFactor x strength, times the (sRGB) emissive texture where there is one.
+        em = shape["emitter"]
+        self.assertEqual(em["type"], "area")
+        self.assertEqual(em["radiance"]["value"], [4.0, 2.0, 1.0])
+        self.assertEqual(conv.scene["integrator"]["type"], "volpath")
+        self.assertIn("mask", conv.plugins())
+
+    def test_embedded_images_are_extracted_with_their_bytes(self):
+        images = [{"bufferView": 4, "mimeType": "image/png"},
+                  {"uri": "data:image/jpeg;base64," + __import__("base64").b64encode(FAKE_JPEG).decode()}]
+        textures = [{"source": 0}, {"source": 1}]
+        mats = [{"name": "a", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}},
+                {"name": "b", "pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}}]
+        conv = self.scene(quad_doc(mats, images, textures), [FAKE_PNG])
+        files = [self.bsdf_of(conv, s)["base_color"]["filename"] for s in self.shapes(conv, "ply")]
+        self.assertEqual([os.path.splitext(f)[1] for f in files], [".png", ".jpg"])
+        for f, data in zip(files, (FAKE_PNG, FAKE_JPEG)):
+            self.assertEqual(os.path.dirname(f), mp.cache_dir())
+            with open(f, "rb") as fh:
+                self.assertEqual(fh.read(), data)
+
+    def test_one_sided_specular_and_blend(self):
+        mats = [{"name": "plain", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.9, 0.5],
+                                                           "metallicFactor": 0, "roughnessFactor": 0.5},
+                 "alphaMode": "BLEND", "extensions": {"KHR_materials_specular": {"specularFactor": 0.5}}}]
+        conv = self.scene(quad_doc(mats, [], []))
+        mask = self.bsdf_of(conv, self.shapes(conv, "ply")[0])
+        self.assertEqual((mask["type"], mask["opacity"]), ("mask", 0.5))   # a constant BLEND alpha
+        b = mask["bsdf"]
+        self.assertEqual(b["type"], "principled")                         # one-sided: bare (a black back)
+        self.assertNotIn("metallic", b)
+        r = math.sqrt(0.5 * 0.04)                                          # the index whose f0 is s f0
+        self.assertAlmostEqual(b["eta"], (1 + r) / (1 - r), places=9)
+        self.assertTrue(any("specular 0.5 -> eta" in n for n in conv.notes))
+
+    def test_clearcoat_transmission_volume(self):
+        mats = [{"name": "coat", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.1, 0.1, 1], "metallicFactor": 0},
+                 "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.5, "clearcoatRoughnessFactor": 0.2}}},
+                {"name": "thin", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0.3},
+                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.75},
+                                "KHR_materials_ior": {"ior": 1.33}}},
+                {"name": "volume", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+                 "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                                "KHR_materials_volume": {"thicknessFactor": 0.3, "attenuationDistance": 0.2,
+                                                         "attenuationColor": [0.9, 0.3, 0.2]}}}]
+        conv = self.scene(quad_doc(mats, [], []))
+        coat, thin, volume = self.shapes(conv, "ply")
+        b = self.bsdf_of(conv, coat)
+        self.assertEqual(b["type"], "principled")                         # one-sided
+        self.assertAlmostEqual(b["clearcoat"], 2.0)                       # 4 c: Mitsuba scales its coat by 0.25
+        self.assertAlmostEqual(b["clearcoat_gloss"], (0.1 - 0.04) / 0.099)  # GTR1 alpha = r^2
+        b = self.bsdf_of(conv, thin)
+        self.assertEqual((b["type"], b["spec_trans"], b["eta"], b["roughness"]), ("principledthin", 0.75, 1.33, 0.3))
+        b = self.bsdf_of(conv, volume)
+        self.assertEqual((b["type"], b["spec_trans"], b["eta"]), ("principled", 1.0, 1.5))   # refracts: not twosided
+        medium = volume["interior"]
+        self.assertEqual((medium["type"], medium["albedo"]), ("homogeneous", 0.0))
+        self.assertTrue(close(medium["sigma_t"]["value"]["value"], [-math.log(c) / 0.2 for c in (0.9, 0.3, 0.2)]))
+        self.assertNotIn("interior", coat)
+        self.assertEqual(conv.scene["integrator"]["type"], "volpath")
+        notes = " ".join(conv.notes)
+        for fragment in ("clearcoat = 4 c", "GTR1", "principledthin", "sqrt(base colour)", "homogeneous medium"):
+            self.assertIn(fragment, notes)
+
+    def test_punctual_lights_are_placed_by_node_and_instance(self):
+        half = math.radians(-90) / 2                                       # -z turned to -y
+        down = [math.sin(half), 0, 0, math.cos(half)]
+        lights = [{"type": "point", "intensity": 10, "color": [1, 0.5, 0.25]},
+                  {"type": "spot", "intensity": 20, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.4},
+                   "range": 5},
+                  {"type": "directional", "intensity": 2}]
+        nodes = [{"mesh": 0},
+                 {"translation": [0, 0.5, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                 {"translation": [0.3, 0.6, 0], "rotation": down, "extensions": {"KHR_lights_punctual": {"light": 1}}},
+                 {"rotation": down, "extensions": {"KHR_lights_punctual": {"light": 2}}}]
+        mats = [{"name": "grey", "pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1]}}]
+        conv = self.scene(quad_doc(mats, [], [], nodes=nodes, lights=lights),
+                          instances=[{"mesh": "t", "translate": [1, 0, 2]}, {"mesh": "t", "translate": [-1, 0, 0]}])
+        points, spots, suns = (self.shapes(conv, k) for k in ("point", "spot", "directional"))
+        self.assertEqual((len(points), len(spots), len(suns)), (2, 2, 2))   # each instance's
+        self.assertTrue(close(points[0]["position"], [1, 0.5, 2]))
+        self.assertTrue(close(points[1]["position"], [-1, 0.5, 0]))
+        self.assertEqual(points[0]["intensity"]["value"], [10, 5, 2.5])   # candela = W/sr
+        self.assertAlmostEqual(points[0]["sampling_weight"], 4 * 17.5 / 3, places=4)
+        spot = spots[0]
+        self.assertEqual(spot["intensity"]["value"], [20, 20, 20])
+        self.assertAlmostEqual(spot["cutoff_angle"], math.degrees(0.4))
+        self.assertAlmostEqual(spot["beam_width"], math.degrees(0.2))
+        m = spot["to_world"]["__transform__"]
+        self.assertTrue(close(col(m, 3), [1.3, 0.6, 2]))                  # at the node's origin, placed
+        self.assertTrue(close(col(m, 2), [0, -1, 0]))                     # shining down its -z: down
+        self.assertAlmostEqual(spot["sampling_weight"], 2 * (1 - math.cos(0.4)) * 20, places=4)
+        self.assertTrue(close(suns[0]["direction"], [0, -1, 0]))
+        self.assertEqual(suns[0]["irradiance"]["value"], [2, 2, 2])       # lux = W/m^2
+        self.assertGreater(suns[0]["sampling_weight"], 0)
+        notes = " ".join(conv.notes)
+        self.assertIn("range 5", notes)
+        self.assertIn("linearly in the angle", notes)
+        # nee 0: area lights go unsampled; punctual ones are reached by light sampling alone.
+        conv = mp.convert(os.path.join(self.tmp, "scene.json"), nee=0)
+        self.assertGreater(self.shapes(conv, "point")[0]["sampling_weight"], 0)
+
+    def test_scene_file_principled(self):
+        materials = [{"name": "p", "type": "principled", "albedo": [0.3, 0.4, 0.5], "metallic": 0.5,
+                      "roughness": 0.4, "anisotropy": 0.5, "emission": [2, 2, 2]}]
+        conv = self.convert(scene_doc(materials=materials, spheres=[{"center": [0, 0, 0], "radius": 1,
+                                                                    "material": "p"}]))
+        sphere = self.shapes(conv, "sphere")[0]
+        b = self.bsdf_of(conv, sphere)
+        self.assertEqual(b["type"], "twosided")                           # scene files default to two-sided
+        self.assertEqual((b["bsdf"]["metallic"], b["bsdf"]["anisotropic"]), (0.5, 0.5))
+        self.assertEqual(sphere["emitter"]["radiance"]["value"], [2.0, 2.0, 2.0])
+
+
+class TileRegionsTest(Base):
+    def test_two_tiles_land_where_the_camera_projects_them(self):
+        write_gltf_glb(os.path.join(self.tmp, "t.glb"),
+                       quad_doc([{"name": "grey"}], [], []), QUAD_BLOBS)
+        cam = {"look_from": [0, 3, 4], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "vfov": 45}
+        doc = scene_doc(camera=cam, spheres=[], meshes=[{"name": "t", "file": "t.glb"}],
+                        instances=[{"mesh": "t", "translate": [-1, 0, 0]}, {"mesh": "t", "translate": [1, 0, 1]}])
+        path = os.path.join(self.tmp, "tiles.json")
+        with open(path, "w") as f:
+            json.dump(doc, f)
+        regions = mp.tile_regions(path, 320, 180)
+        self.assertEqual((regions["width"], regions["height"]), (320, 180))
+        a, b = regions["tiles"]
+        import make_materials as mm
+        proj = mm.Projection(cam, 320, 180)
+        for tile, centre in ((a, [-1, 0, 0]), (b, [1, 0, 1])):
+            px, py = proj.pixel(centre)                                   # the quad's centre (flat: y = 0)
+            self.assertAlmostEqual(tile["center_px"][0], px, places=2)
+            self.assertAlmostEqual(tile["center_px"][1], py, places=2)
+            x0, y0, x1, y1 = tile["inner"]
+            self.assertLessEqual(abs((x0 + x1) / 2 - px), 1)
+            self.assertLessEqual(abs((y0 + y1) / 2 - py), 1)
+            corners = [proj.pixel([centre[0] + dx, 0, centre[2] + dz]) for dx in (-0.5, 0.5) for dz in (-0.5, 0.5)]
+            bx0, by0, bx1, by1 = tile["bbox"]
+            self.assertEqual([bx0, by0], [math.floor(min(c[0] for c in corners)), math.floor(min(c[1] for c in corners))])
+            self.assertEqual([bx1, by1], [math.ceil(max(c[0] for c in corners)), math.ceil(max(c[1] for c in corners))])
+            self.assertTrue(bx0 < x0 < x1 < bx1 and by0 < y0 < y1 < by1)
+        self.assertLess(a["center_px"][0], 160)                           # -x on the left
+        self.assertGreater(b["center_px"][1], a["center_px"][1])           # nearer: lower in the image
+        out = os.path.join(self.tmp, "regions.json")
+        self.assertEqual(mp.main(["regions", path, "--width", "320", "--height", "180", "-o", out]), 0)
+        with open(out) as f:
+            self.assertEqual(json.load(f)["tiles"], regions["tiles"])
 
 
 class PassPlanTest(unittest.TestCase):
@@ -730,7 +982,11 @@ class TexturedMaterialTest(Base):
         self.assertEqual(flat["type"], "diffuse")                         # strength 0: no perturbation
         self.assertEqual(proc["type"], "twosided")                        # not mapped
         notes = " ".join(conv.notes)
-        for fragment in ("normal_strength 0.5 of 'l'", "normal_texture 'squares' of 'proc': a checker texture "
+        # The strength scales the map's x and y before Mitsuba normalises it.
+        self.assertEqual((l["normalmap"]["type"], l["normalmap"]["strength"]), ("wt_normal_scale", 0.5))
+        self.assertEqual(l["normalmap"]["texture"]["type"], "bitmap")
+        self.assertEqual(p["normalmap"]["type"], "bitmap")               # strength 1: the map itself
+        for fragment in ("normal_texture 'squares' of 'proc': a checker texture "
                          "used as a normal map does not map", "normal maps on spheres", "flip_invalid_normals",
                          "its y (green) the same way"):
             self.assertIn(fragment, notes)
@@ -762,7 +1018,10 @@ class TexturedMaterialTest(Base):
         self.assertEqual(modes, ["repeat", "clamp", "mirror"])
         notes = " ".join(conv.notes)
         self.assertIn("wavetrace repeat u and clamp v", notes)            # the default: [repeat, clamp]
-        self.assertIn("image texture 'c': its uv_scale, uv_offset and uv_rotation are not converted", notes)
+        # uv_scale (2, 2) after the sphere's own turn: to_uv = scale x SPHERE_TO_UV.
+        c = self.bsdf_of(conv, self.shapes(conv, "sphere")[2])["reflectance"]
+        self.assertEqual(c["to_uv"]["__transform__"], mp.mat_mul(mp.mat_scale([2, 2, 1]), mp.SPHERE_TO_UV))
+        self.assertNotIn("not converted", notes)
 
 
 class ConductorPresetsTest(Base):
@@ -1078,6 +1337,14 @@ class MitsubaModelTest(Base):
             scene = mp.load_scene(conv, "scalar_rgb")
             self.assertGreater(len(scene.shapes()), 0, stem)
 
+    @unittest.skipUnless(os.path.isdir(os.path.join(ROOT, "scenes", "generated", "tiles")),
+                         "the glTF tiles are not generated (build/wavetrace-gltf-tiles scenes/generated/tiles)")
+    def test_gltf_tiles_load_and_render(self):
+        conv = mp.convert(os.path.join(ROOT, "scenes", "gltf-tiles.json"), width=16, height=9, spp=1)
+        scene = mp.load_scene(conv, "scalar_rgb")
+        self.assertGreater(len(scene.emitters()), 3)
+        self.mi.render(scene, spp=1)
+
 
 class EmittedPluginsTest(Base):
     def test_every_emitted_plugin_is_listed(self):
@@ -1087,6 +1354,9 @@ class EmittedPluginsTest(Base):
             conv = mp.convert(os.path.join(ROOT, "scenes", name + ".json"))
             extra = set(conv.plugins()) - set(mp.EMITTED_PLUGINS) - set(mp.PYTHON_PLUGINS)
             self.assertEqual(extra, set(), name)
+        if os.path.isdir(os.path.join(ROOT, "scenes", "generated", "tiles")):
+            conv = mp.convert(os.path.join(ROOT, "scenes", "gltf-tiles.json"))
+            self.assertEqual(set(conv.plugins()) - set(mp.EMITTED_PLUGINS) - set(mp.PYTHON_PLUGINS), set())
 
     def test_peer_pack_keeps_every_emitted_plugin(self):
         # scripts/peer-pack.sh's PLUGINS: what the trimmed package keeps ("scene" is

@@ -31,10 +31,12 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # and regular for the rgb variants' illuminants, merge for the scene's shape
 # merging): found by recording the plugins a process had mapped after loading and
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
-# "scene" is part of libmitsuba.
+# "scene" is part of libmitsuba. The glTF tiles add principledthin, mask, the
+# punctual lights (point, spot, directional), and volpath with a homogeneous
+# medium of a constvolume for absorbing volumes.
 PLUGINS="area bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
 normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
-srgb thindielectric thinlens twosided uniform"
+srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume"
 
 py_local=$(command -v python3)
 export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1
