@@ -27,14 +27,14 @@ out=$out_dir/mitsuba-peer.tar.xz
 mkdir -p "$wheels" "$out_dir" "$build"
 
 # Every plugin the converter emits (bench/mitsuba_peer.py, EMITTED_PLUGINS) and what
-# loading them pulls in (srgb for 'rgb' values, uniform for float parameters, d65
+# loading them pulls in (isotropic, the homogeneous medium's default phase function; srgb for 'rgb' values, uniform for float parameters, d65
 # and regular for the rgb variants' illuminants, merge for the scene's shape
 # merging): found by recording the plugins a process had mapped after loading and
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
 # "scene" is part of libmitsuba. The glTF tiles add principledthin, mask, the
 # punctual lights (point, spot, directional), and volpath with a homogeneous
 # medium of a constvolume for absorbing volumes.
-PLUGINS="area bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
+PLUGINS="area isotropic bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
 normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
 srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume"
 

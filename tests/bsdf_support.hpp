@@ -222,4 +222,59 @@ inline Furnace furnace(const Case& c, const vec3& wo) {
   return Furnace{m, std::sqrt(std::fmax(sum2 / n - m * m, 0.0) / n)};
 }
 
+// Every non-specular sample's weight is eval / pdf and its pdf pdf(), to float
+// rounding, at kAngles from both sides.
+inline void expect_weights_are_eval_over_pdf(const Case& c) {
+  for (double deg : kAngles) {
+    for (bool outside : {true, false}) {
+      const vec3 wo = incident(deg, outside);
+      const BsdfAt b = at(c, wo);
+      int checked = 0;
+      for (int i = 0; i < 2000; ++i) {
+        const BsdfSample s = sample_bsdf(b, wo, Rng::at(5, static_cast<uint32_t>(i), 0, 0));
+        if (s.lobe == 0u || (s.lobe & kLobeSpecular)) continue;
+        float pdf;
+        const vec3 f = eval_bsdf(b, wo, s.wi, pdf);
+        ASSERT_NEAR(pdf, s.pdf, 1e-3f * s.pdf) << label(c, deg) << " sample " << i;
+        for (int k = 0; k < 3; ++k) {
+          ASSERT_NEAR(s.weight[k], f[k] / pdf, 2e-3f * s.weight[k] + 1e-6f) << label(c, deg) << " sample " << i;
+        }
+        ++checked;
+      }
+      EXPECT_GT(checked, 500) << label(c, deg);
+    }
+  }
+}
+
+// Reciprocity over 4000 pairs of directions drawn uniformly over the sphere, both
+// ways round: f(wo, wi) = f(wi, wo), and through an interface f / n^2 of wo's side,
+// n being `inside` below the surface and 1 above it (glass's radiance scaling; 1
+// where nothing refracts). The pairs where f is not 0, and those of them that cross.
+struct ReciprocalPairs {
+  int nonzero = 0, crossing = 0;
+};
+inline ReciprocalPairs reciprocal_pairs(const Case& c, float inside) {
+  ReciprocalPairs out;
+  for (int i = 0; i < 4000; ++i) {
+    const Rng rng = Rng::at(9, static_cast<uint32_t>(i), 0, 0);
+    const vec3 a = unit_sphere_point(rng.uniform(0), rng.uniform(1));
+    const vec3 d = unit_sphere_point(rng.uniform(2), rng.uniform(3));
+    const bool reflection = (a.z > 0) == (d.z > 0);
+    if (std::fabs(a.z) < 0.02f || std::fabs(d.z) < 0.02f) continue;
+    const vec3 f_ad = eval_bsdf(at(c, a), a, d) / std::fabs(d.z);
+    const vec3 f_da = eval_bsdf(at(c, d), d, a) / std::fabs(a.z);
+    const float n_a = a.z > 0 ? 1.0f : inside, n_d = d.z > 0 ? 1.0f : inside;
+    for (int k = 0; k < 3; ++k) {
+      const float x = reflection ? f_ad[k] : f_ad[k] / (n_a * n_a);
+      const float y = reflection ? f_da[k] : f_da[k] / (n_d * n_d);
+      // (1e-5 absolute: near total internal reflection 1 - F cancels.)
+      EXPECT_NEAR(x, y, 2e-3f * std::fmax(x, y) + 1e-5f) << c.name << " pair " << i;
+      if (std::fabs(x - y) > 2e-3f * std::fmax(x, y) + 1e-5f) return out;
+    }
+    if (f_ad.x > 0.0f) ++out.nonzero;
+    if (f_ad.x > 0.0f && !reflection) ++out.crossing;
+  }
+  return out;
+}
+
 }  // namespace wt

@@ -94,6 +94,21 @@ inline void expect_same_expectation(const std::vector<double>& a, const std::vec
                                     << " against " << mb << " +- " << sb;
 }
 
+// Renders that lose no light return the sky's radiance 1 in every pixel: the mean
+// of 16 seeds' CPU renders (w x h at spp, no roulette before `depth`) within 4
+// standard errors of 1 (plus 1e-6, for the float sums of scenes whose every path
+// returns 1), and 4 standard errors at most 0.5%.
+inline void expect_vanishes_under_a_uniform_sky(const Scene& scene, int w, int h, int spp, int depth,
+                                                const std::string& what) {
+  std::vector<double> means;
+  for (uint32_t seed = 1; seed <= 16; ++seed) {
+    means.push_back(mean(render(scene, options_for(Backend::Cpu, Kernel::Megakernel, w, h, spp, depth, depth, seed)).rgb));
+  }
+  const MeanAndError e = mean_and_standard_error(means);
+  EXPECT_NEAR(e.mean, 1.0, 4 * e.standard_error + 1e-6) << what << ": standard error " << e.standard_error;
+  EXPECT_LT(4 * e.standard_error, 0.005) << what;
+}
+
 // The scene's sky made a LatLong environment of radiance 1 everywhere (a w x h
 // image: every lookup blends texels of 1), its lights and table rebuilt for it.
 inline void set_constant_environment(Scene& scene, int w, int h) {

@@ -32,7 +32,7 @@ struct BsdfInputs {
 
 // Principled's textured coat (weight: red; roughness: green; its normal map) and
 // transmission (red), looked up where the material has them.
-WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
+WT_HD WT_OUTLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
   auto channel = [&](int32_t texture, int c) {
     return fminf(fmaxf(eval_texture(in.textures[texture], in.images, sp)[c], 0.0f), 1.0f);
   };
@@ -123,7 +123,7 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
     case MaterialKind::Dielectric: return dielectric_sample(b, wo, rng);
     case MaterialKind::Coated: return coated_sample(b, wo, rng);
     case MaterialKind::Conductor:
-      if constexpr (Microfacet) return conductor_sample(b, wo, rng);
+      if constexpr (Microfacet) return conductor_sample(b, conductor_lobe(b), wo, rng);
       break;
     case MaterialKind::Glass:
       if constexpr (Microfacet) return glass_sample(b, wo, rng);
@@ -159,8 +159,8 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
       break;
     case MaterialKind::Conductor:
       if constexpr (Microfacet) {
-        pdf = conductor_pdf(b, wo, wi);
-        f = conductor_eval(b, wo, wi);
+        pdf = conductor_pdf(b, conductor_lobe(b), wo, wi);
+        f = conductor_eval(b, conductor_lobe(b), wo, wi);
       }
       break;
     case MaterialKind::Glass:

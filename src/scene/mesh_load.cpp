@@ -853,6 +853,27 @@ bool extension_texture(const tinygltf::ExtensionMap& extensions, const char* ext
   return true;
 }
 
+// An extension's colour field (3 numbers, each in [0, most]) into `out`, where the
+// field is given; otherwise an error naming it.
+void extension_colour(const tinygltf::ExtensionMap& extensions, const char* extension, const char* field, double most,
+                      const std::string& path, const std::string& what, vec3& out) {
+  auto e = extensions.find(extension);
+  if (e == extensions.end() || !e->second.IsObject() || !e->second.Has(field)) return;
+  const tinygltf::Value& c = e->second.Get(field);
+  double rgb[3] = {-1.0, -1.0, -1.0};
+  if (c.IsArray() && c.ArrayLen() == 3) {
+    for (int i = 0; i < 3; ++i) rgb[i] = c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : -1.0;
+  }
+  for (double v : rgb) {
+    if (!(v >= 0.0 && v <= most)) {
+      std::ostringstream bound;
+      bound << most;
+      fail(path, what + ": " + extension + " " + field + " must be 3 numbers in [0, " + bound.str() + "]");
+    }
+  }
+  out = vec3(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
+}
+
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
 // KTX2's file identifier, the first 12 bytes of every KTX2 file.
@@ -1065,18 +1086,7 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
   out.metallic = unit(pbr.metallicFactor, "metallicFactor");
   out.specular = unit(extension_number(g.extensions, "KHR_materials_specular", "specularFactor", 1.0),
                       "KHR_materials_specular specularFactor");
-  auto specular = g.extensions.find("KHR_materials_specular");
-  if (specular != g.extensions.end() && specular->second.IsObject() && specular->second.Has("specularColorFactor")) {
-    const tinygltf::Value& c = specular->second.Get("specularColorFactor");
-    double rgb[3] = {-1.0, -1.0, -1.0};
-    if (c.IsArray() && c.ArrayLen() == 3) {
-      for (int i = 0; i < 3; ++i) rgb[i] = c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : -1.0;
-    }
-    for (double v : rgb) {
-      if (!(v >= 0.0 && v <= 1e3)) fail(path, what + ": KHR_materials_specular specularColorFactor must be 3 numbers in [0, 1000]");
-    }
-    out.specular_color = vec3(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
-  }
+  extension_colour(g.extensions, "KHR_materials_specular", "specularColorFactor", 1e3, path, what, out.specular_color);
   {
     tinygltf::NormalTextureInfo info;
     if (extension_texture(g.extensions, "KHR_materials_specular", "specularTexture", path, what, info)) {
@@ -1131,17 +1141,7 @@ MeshMaterial map_gltf(GltfImages& images, const tinygltf::Material& g, size_t in
       fail(path, what + ": KHR_materials_volume attenuationDistance must be a number > 0");
     }
     out.attenuation_distance = static_cast<float>(distance);
-    if (volume->second.Has("attenuationColor")) {
-      const tinygltf::Value& c = volume->second.Get("attenuationColor");
-      double rgb[3] = {-1.0, -1.0, -1.0};
-      if (c.IsArray() && c.ArrayLen() == 3) {
-        for (int i = 0; i < 3; ++i) rgb[i] = c.Get(i).IsNumber() ? c.Get(i).GetNumberAsDouble() : -1.0;
-      }
-      for (double v : rgb) {
-        if (!(v >= 0.0 && v <= 1.0)) fail(path, what + ": KHR_materials_volume attenuationColor must be 3 numbers in [0, 1]");
-      }
-      out.attenuation_color = vec3(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]), static_cast<float>(rgb[2]));
-    }
+    extension_colour(g.extensions, kVolume, "attenuationColor", 1.0, path, what, out.attenuation_color);
   }
   if (pbr.baseColorTexture.index >= 0) out.albedo_map = texture(pbr.baseColorTexture, "base colour texture");
   if (out.alpha_mode != 0) out.alpha_map = out.albedo_map;

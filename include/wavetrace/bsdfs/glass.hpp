@@ -19,22 +19,35 @@ namespace wt {
 
 WT_HD WT_INLINE Ggx glass_ggx(const BsdfAt& b) { return Ggx{b.p.ax, b.p.ay, (b.flags & kMaterialSeparable) != 0}; }
 
+// A glass interface as its functions read it (principled's volume makes one without
+// copying the whole BsdfAt).
+struct GlassLobe {
+  uint32_t flags;  // kMaterialThin, kMaterialCompensated
+  float ior;
+  vec3 tint;
+  int32_t table, rows;  // its energy tables (-1: none), 1 or kEnergySize rows by roughness
+  const float* tables;
+};
+
+WT_HD WT_INLINE GlassLobe glass_lobe(const BsdfAt& b) {
+  return GlassLobe{b.flags, b.ior, b.albedo, b.p.table, b.p.table_rows, b.tables};
+}
+
 // 1 / E(mu_o) on wo's side where the glass is compensated, else 1.
-WT_HD WT_INLINE float glass_compensation(const BsdfAt& b, const vec3& wo) {
-  if (!(b.flags & kMaterialCompensated) || b.p.table < 0) return 1.0f;
-  const int rows = b.p.table_rows;
-  const float* t = b.tables + b.p.table + (wo.z > 0.0f ? 0 : rows * kEnergySize);
-  return 1.0f / fmaxf(rows_table(t, rows, table_roughness(glass_ggx(b)), fabsf(wo.z)), 1e-3f);
+WT_HD WT_INLINE float glass_compensation(const GlassLobe& c, const Ggx& g, const vec3& wo) {
+  if (!(c.flags & kMaterialCompensated) || c.table < 0) return 1.0f;
+  const float* t = c.tables + c.table + (wo.z > 0.0f ? 0 : c.rows * kEnergySize);
+  return 1.0f / fmaxf(rows_table(t, c.rows, table_roughness(g), fabsf(wo.z)), 1e-3f);
 }
 
 // f cos and the density, local frame about the outward normal (wo on either side).
 // Single scattering (no compensation) when `single`.
-WT_HD WT_INLINE vec3 glass_eval_local(const BsdfAt& b, const Ggx& g, const vec3& wo, const vec3& wi, float& pdf,
+WT_HD WT_INLINE vec3 glass_eval_local(const GlassLobe& c, const Ggx& g, const vec3& wo, const vec3& wi, float& pdf,
                                       bool single = false) {
   pdf = 0.0f;
   if (wo.z == 0.0f || wi.z == 0.0f) return vec3(0.0f);
   const bool outside = wo.z > 0.0f;
-  const float eta = outside ? b.ior : 1.0f / b.ior;  // transmitted over incident, for wo's side
+  const float eta = outside ? c.ior : 1.0f / c.ior;  // transmitted over incident, for wo's side
   const bool reflection = (wo.z > 0.0f) == (wi.z > 0.0f);
   const float etap = reflection ? 1.0f : eta;
   vec3 h = wo + wi * etap;
@@ -49,7 +62,7 @@ WT_HD WT_INLINE vec3 glass_eval_local(const BsdfAt& b, const Ggx& g, const vec3&
   const float f_r = fresnel_dielectric(fabsf(ho), eta);
   const float visible = g.visible_d(wu, h);
   const float dg = g.d(h) * g.g2(wo, wi);
-  const float scale = single ? 1.0f : glass_compensation(b, wo);
+  const float scale = single ? 1.0f : glass_compensation(c, g, wo);
   if (reflection) {
     pdf = visible * f_r / (4.0f * fabsf(ho));
     return vec3(f_r * dg * scale / (4.0f * fabsf(wo.z)));
@@ -57,44 +70,44 @@ WT_HD WT_INLINE vec3 glass_eval_local(const BsdfAt& b, const Ggx& g, const vec3&
   const float denom = hi + ho / eta;
   const float jacobian = fabsf(hi) / (denom * denom);
   pdf = visible * (1.0f - f_r) * jacobian;
-  return b.albedo * ((1.0f - f_r) * dg * fabsf(ho) * jacobian * scale /
-                     (WT_MUTANT(GlassUnscaledRadiance) ? fabsf(wo.z) : fabsf(wo.z) * eta * eta));
+  return c.tint * ((1.0f - f_r) * dg * fabsf(ho) * jacobian * scale /
+                   (WT_MUTANT(GlassUnscaledRadiance) ? fabsf(wo.z) : fabsf(wo.z) * eta * eta));
 }
 
-WT_HD WT_INLINE BsdfSample glass_sample_local(const BsdfAt& b, const vec3& wo, const Rng& rng, bool single = false) {
+WT_HD WT_INLINE BsdfSample glass_sample_local(const GlassLobe& c, const Ggx& g, const vec3& wo, const Rng& rng,
+                                              bool single = false) {
   if (wo.z == 0.0f) return no_sample();
   const bool outside = wo.z > 0.0f;
   const float s = outside ? 1.0f : -1.0f;
   const vec3 wu = s * wo;
-  if (b.flags & kMaterialThin) {
-    const float r = fresnel_dielectric(wu.z, b.ior);
+  if (c.flags & kMaterialThin) {
+    const float r = fresnel_dielectric(wu.z, c.ior);
     const float rt = r < 1.0f ? r + (1.0f - r) * (1.0f - r) * r / (1.0f - r * r) : 1.0f;
     if (rng.uniform(kDimLayer) < rt) return BsdfSample{vec3(-wo.x, -wo.y, wo.z), vec3(1.0f), 0.0f, kLobeSpecular | kLobeReflection};
-    return BsdfSample{-wo, b.albedo, 0.0f, kLobeSpecular | kLobeTransmission};
+    return BsdfSample{-wo, c.tint, 0.0f, kLobeSpecular | kLobeTransmission};
   }
-  const float eta = outside ? b.ior : 1.0f / b.ior;
-  const Ggx g = glass_ggx(b);
+  const float eta = outside ? c.ior : 1.0f / c.ior;
   if (g.smooth()) {
     const float f_r = fresnel_dielectric(wu.z, eta);
     if (rng.uniform(kDimLayer) < f_r) return BsdfSample{vec3(-wo.x, -wo.y, wo.z), vec3(1.0f), 0.0f, kLobeSpecular | kLobeReflection};
     const float cos_t = refracted_cos(wu.z, eta);
     const vec3 wi = vec3(-wo.x / eta, -wo.y / eta, -s * cos_t);
-    return BsdfSample{wi, b.albedo * (1.0f / (eta * eta)), 0.0f, kLobeSpecular | kLobeTransmission};
+    return BsdfSample{wi, c.tint * (1.0f / (eta * eta)), 0.0f, kLobeSpecular | kLobeTransmission};
   }
   const vec3 h = g.sample_visible(wu, rng.uniform(kDimScatterA), rng.uniform(kDimScatterB));
-  const float c = glm::dot(wu, h);
+  const float cs = glm::dot(wu, h);
   vec3 wi;
-  if (rng.uniform(kDimLayer) < fresnel_dielectric(c, eta)) {
+  if (rng.uniform(kDimLayer) < fresnel_dielectric(cs, eta)) {
     wi = reflect_about(wu, h);
     if (wi.z <= 0.0f) return no_sample();
   } else {
-    const float cos_t = refracted_cos(c, eta);
-    wi = -wu * (1.0f / eta) + (c / eta - cos_t) * h;
+    const float cos_t = refracted_cos(cs, eta);
+    wi = -wu * (1.0f / eta) + (cs / eta - cos_t) * h;
     if (wi.z >= 0.0f) return no_sample();
   }
   wi = s * glm::normalize(wi);
   float pdf;
-  const vec3 f = glass_eval_local(b, g, wo, wi, pdf, single);
+  const vec3 f = glass_eval_local(c, g, wo, wi, pdf, single);
   if (!(pdf > 0.0f)) return no_sample();
   const uint32_t side = (wi.z > 0.0f) == outside ? kLobeReflection : kLobeTransmission;
   return BsdfSample{wi, f * (1.0f / pdf), pdf, kLobeGlossy | side};
@@ -102,7 +115,7 @@ WT_HD WT_INLINE BsdfSample glass_sample_local(const BsdfAt& b, const vec3& wo, c
 
 WT_HD WT_INLINE BsdfSample glass_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   const Frame fr = b.outward_frame();
-  BsdfSample s = glass_sample_local(b, fr.to_local(wo_world), rng);
+  BsdfSample s = glass_sample_local(glass_lobe(b), glass_ggx(b), fr.to_local(wo_world), rng);
   if (s.lobe == 0u) return s;
   s.wi = fr.to_world(s.wi);
   // A reflection must stay on wo's side of the geometric surface, a transmission cross it.
@@ -117,7 +130,7 @@ WT_HD WT_INLINE vec3 glass_eval(const BsdfAt& b, const vec3& wo, const vec3& wi,
   const Frame fr = b.outward_frame();
   const vec3 lo = fr.to_local(wo), li = fr.to_local(wi);
   if (b.same_side(wi) != ((lo.z > 0.0f) == (li.z > 0.0f))) return vec3(0.0f);
-  return glass_eval_local(b, g, lo, li, pdf);
+  return glass_eval_local(glass_lobe(b), g, lo, li, pdf);
 }
 
 }  // namespace wt

@@ -94,30 +94,25 @@ WT_HD WT_INLINE vec3 plastic_base_eval(const BsdfAt& b, const vec3& wo, const ve
 
 // A metallic plastic's metal: a Schlick conductor of f0 = albedo (F_avg = f0 +
 // (1 - f0) / 21, Schlick's cosine-weighted mean) on the coat's lobe.
-WT_HD WT_INLINE BsdfAt plastic_metal(const BsdfAt& b) {
-  BsdfAt m = b;
-  m.kind = MaterialKind::Conductor;
-  m.flags = (b.flags & kMaterialSeparable) | kMaterialSchlick | (b.p.metal_table >= 0 ? static_cast<uint32_t>(kMaterialCompensated) : 0u);
-  m.p.eta = b.albedo;
-  m.p.table = b.p.metal_table;
-  m.p.fresnel_average = b.albedo + (vec3(1.0f) - b.albedo) * (1.0f / 21.0f);
-  return m;
+WT_HD WT_INLINE ConductorLobe plastic_metal(const BsdfAt& b) {
+  return schlick_lobe(b.p.metal_table >= 0 ? static_cast<uint32_t>(kMaterialCompensated) : 0u, b.albedo, b.p.metal_table,
+                      b.tables);
 }
 
 WT_HD WT_INLINE vec3 plastic_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   const float m = b.p.metallic;
   vec3 f = plastic_base_eval(b, wo, wi, pdf);
   if (!(m > 0.0f)) return f;
-  const BsdfAt metal = plastic_metal(b);
-  const float metal_pdf = conductor_pdf(metal, wo, wi);
+  const ConductorLobe metal = plastic_metal(b);
+  const float metal_pdf = conductor_pdf(b, metal, wo, wi);
   pdf = (1.0f - m) * pdf + m * metal_pdf;
-  return (1.0f - m) * f + m * conductor_eval(metal, wo, wi);
+  return (1.0f - m) * f + m * conductor_eval(b, metal, wo, wi);
 }
 
 WT_HD WT_INLINE BsdfSample plastic_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   const float m = b.p.metallic;
   if (!(m > 0.0f)) return plastic_base_sample(b, wo_world, rng);
-  BsdfSample s = rng.uniform(kDimLobe) < m ? conductor_sample(plastic_metal(b), wo_world, rng)
+  BsdfSample s = rng.uniform(kDimLobe) < m ? conductor_sample(b, plastic_metal(b), wo_world, rng)
                                            : plastic_base_sample(b, wo_world, rng);
   // A delta lobe's weight is its component's (the pick's probability cancels the
   // mixture's factor); any other direction is weighed by the whole mixture.

@@ -79,25 +79,14 @@ WT_HD WT_INLINE float principled_f0(const BsdfAt& b) {
 // A glossy lobe as a Schlick conductor of reflectance f0 (compensated where the
 // material is): the dielectric's specular at f0 = F_d's, the metal's at the albedo,
 // the coat's at kCoatF0.
-WT_HD WT_INLINE BsdfAt principled_lobe(const BsdfAt& b, const vec3& f0) {
-  BsdfAt c = b;
-  c.kind = MaterialKind::Conductor;
-  c.flags = (b.flags & (kMaterialSeparable | kMaterialCompensated)) | kMaterialSchlick;
-  c.p.eta = f0;
-  c.p.table = b.p.metal_table;
-  c.p.fresnel_average = f0 + (vec3(1.0f) - f0) * (1.0f / 21.0f);
-  return c;
+WT_HD WT_INLINE ConductorLobe principled_lobe(const BsdfAt& b, const vec3& f0) {
+  return schlick_lobe(b.flags, f0, b.p.metal_table, b.tables);
 }
 
 // The volume's share as `glass` sees it: the index, the roughness's energy tables
 // (rows by roughness) and the tint.
-WT_HD WT_INLINE BsdfAt principled_glass(const BsdfAt& b) {
-  BsdfAt c = b;
-  c.kind = MaterialKind::Glass;
-  c.flags = b.flags & (kMaterialSeparable | kMaterialCompensated);
-  c.p.table = b.p.glass_table;
-  c.p.table_rows = kEnergySize;
-  return c;
+WT_HD WT_INLINE GlassLobe principled_glass(const BsdfAt& b) {
+  return GlassLobe{b.flags & kMaterialCompensated, b.ior, b.albedo, b.p.glass_table, kEnergySize, b.tables};
 }
 
 // A Schlick layer's directional albedo E(mu) (from `table`, principled_table at its
@@ -241,7 +230,7 @@ WT_HD WT_INLINE vec3 principled_eval_all(const BsdfAt& b, const vec3& wo_world, 
     l = principled_lobes(b, g, gc, wo.z, mu_oc);
     through = fminf(1.0f - principled_coat_albedo(b, gc, mu_oc), 1.0f - principled_coat_albedo(b, gc, fabsf(ci.z)));
     if (!gc.smooth() && co.z > 0.0f && ci.z > 0.0f) {
-      const BsdfAt coat = principled_lobe(b, vec3(kCoatF0));
+      const ConductorLobe coat = principled_lobe(b, vec3(kCoatF0));
       f += b.p.clearcoat * conductor_eval_local(coat, gc, co, ci);
       pdf += l.coat * conductor_pdf_local(coat, gc, co, ci);
     }
@@ -249,7 +238,7 @@ WT_HD WT_INLINE vec3 principled_eval_all(const BsdfAt& b, const vec3& wo_world, 
     l = principled_lobes(b, g, gc, wo.z, mu_oc);
   }
   const bool thick = principled_thick(b);
-  const BsdfAt metal = principled_lobe(b, b.albedo);
+  const ConductorLobe metal = principled_lobe(b, b.albedo);
   if (wi.z > 0.0f) {
     const vec3 layer = (vec3(1.0f) - principled_layer_albedo(b, g, wo.z)) *
                        (vec3(1.0f) - principled_layer_albedo(b, g, wi.z)) /
@@ -286,7 +275,7 @@ WT_HD WT_INLINE bool principled_culled(const BsdfAt& b) {
   return (b.flags & kMaterialOneSided) && !b.front && !(b.p.transmission > 0.0f);
 }
 
-WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
+WT_HD WT_OUTLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   if (principled_culled(b)) return no_sample();
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world);
@@ -344,7 +333,7 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
     lobe = kLobeGlossy | kLobeTransmission;
   } else {
     const Frame fo = b.outward_frame();
-    BsdfSample s = glass_sample_local(principled_glass(b), fo.to_local(wo_world), rng);
+    BsdfSample s = glass_sample_local(principled_glass(b), g, fo.to_local(wo_world), rng);
     if (s.lobe == 0u) return s;
     s.wi = fo.to_world(s.wi);
     if (b.same_side(s.wi) != ((s.lobe & kLobeReflection) != 0)) return no_sample();
@@ -362,7 +351,7 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
   return BsdfSample{wi_world, f * (1.0f / pdf), pdf, lobe};
 }
 
-WT_HD WT_INLINE vec3 principled_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
+WT_HD WT_OUTLINE vec3 principled_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   pdf = 0.0f;
   if (principled_culled(b)) return vec3(0.0f);
   // A transmitting surface: reflection stays on wo's side of the geometric surface,
