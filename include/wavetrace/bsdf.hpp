@@ -32,7 +32,7 @@ struct BsdfInputs {
 
 // Principled's textured coat (weight: red; roughness: green; its normal map) and
 // transmission (red), looked up where the material has them.
-WT_HD WT_OUTLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
+WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
   auto channel = [&](int32_t texture, int c) {
     return fminf(fmaxf(eval_texture(in.textures[texture], in.images, sp)[c], 0.0f), 1.0f);
   };

@@ -6,13 +6,9 @@
 #if defined(__CUDACC__)
 #define WT_HD __host__ __device__
 #define WT_INLINE __forceinline__
-// A large function kept out of line on the device, so that the registers it needs
-// do not weigh on the kernels that rarely call it.
-#define WT_OUTLINE inline __noinline__
 #else
 #define WT_HD
 #define WT_INLINE inline
-#define WT_OUTLINE inline
 #endif
 
 // GLM's defaulted special members trigger nvcc diagnostic 20012 ("__host__ annotation

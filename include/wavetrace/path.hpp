@@ -15,7 +15,7 @@ constexpr float kRayTMax = 3.0e38f;
 constexpr uint32_t kEverything = kAllKinds | kLightSampling | kMicrofacet;
 
 // Kinds: the primitive kinds the scene holds (geometry.hpp), or a superset.
-template <uint32_t Kinds = kAllKinds, class Scene>
+template <uint32_t Kinds = kAllKinds | kAlphaTested, class Scene>
 WT_HD WT_INLINE Hit intersect_scene(const Scene& scene, const Ray& ray) {
   return intersect_closest<Kinds>(scene, ray, kRayTMax);
 }
@@ -30,7 +30,7 @@ WT_HD WT_INLINE Ray primary_ray(const Scene& scene, const RenderParams& rp, uint
 }
 
 // Whether anything blocks `ray` before tmax (a shadow ray: the first hit ends it).
-template <uint32_t Kinds = kAllKinds, class Scene>
+template <uint32_t Kinds = kAllKinds | kAlphaTested, class Scene>
 WT_HD WT_INLINE bool occluded(const Scene& scene, const Ray& ray, float tmax) {
   if (WT_MUTANT(ShadowIgnoresFirstHit)) {
     const Hit first = intersect_closest<Kinds, false>(scene, ray, tmax);
@@ -152,7 +152,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const RenderParams& r
     emitted = emitted_radiance<Kinds>(scene, lm, Ray{sp.p, s.dir}, at);
     // An alpha-tested emitter gives light where it is there (on average, as a path
     // meets it).
-    if (!spheres_only(Kinds) && scene.instance(light.instance).kind == PrimitiveKind::Triangle) {
+    if ((Kinds & kAlphaTested) && !spheres_only(Kinds) && scene.instance(light.instance).kind == PrimitiveKind::Triangle) {
       emitted *= alpha_coverage(scene, scene.triangle(light.prim).alpha, light.instance, light.prim, s.b1, s.b2);
     }
     // The shadow ray leaves from the offset a ray leaving the surface starts at, and

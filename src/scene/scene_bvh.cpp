@@ -331,6 +331,7 @@ uint32_t Scene::kernel_kinds() const {
   // The microfacet kinds, any material with parameters beyond the study's (a
   // normal map), a mip-mapped image texture and a textured emitter need the kernels
   // that read them.
+  if (!alpha_tests.empty()) kinds |= kAlphaTested;
   for (const Material& m : materials) {
     if (m.params >= 0) kinds |= kMicrofacet;
     if (m.texture >= 0 && static_cast<size_t>(m.texture) < textures.size()) {

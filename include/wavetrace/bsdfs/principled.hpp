@@ -275,7 +275,7 @@ WT_HD WT_INLINE bool principled_culled(const BsdfAt& b) {
   return (b.flags & kMaterialOneSided) && !b.front && !(b.p.transmission > 0.0f);
 }
 
-WT_HD WT_OUTLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
+WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   if (principled_culled(b)) return no_sample();
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world);
@@ -351,7 +351,7 @@ WT_HD WT_OUTLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wo
   return BsdfSample{wi_world, f * (1.0f / pdf), pdf, lobe};
 }
 
-WT_HD WT_OUTLINE vec3 principled_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
+WT_HD WT_INLINE vec3 principled_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   pdf = 0.0f;
   if (principled_culled(b)) return vec3(0.0f);
   // A transmitting surface: reflection stays on wo's side of the geometric surface,

@@ -41,6 +41,11 @@ constexpr uint32_t kLightSampling = 1u << 31;
 // megakernel 5% on seed57 for the BSDFs, and half its speed with the textures, in
 // registers and instructions it never runs.
 constexpr uint32_t kMicrofacet = 1u << 30;
+// Alpha-tested triangles (glTF's MASK and BLEND) are tested in the traversal of the
+// kernels with the features beyond the study's alone, which a scene with alpha
+// selects (Scene::kernel_kinds): compiled into every kernel, the test slowed the
+// megakernel on the study's opaque Cornell box by 18%.
+constexpr uint32_t kAlphaTested = kMicrofacet;
 
 // Whether a kernel compiled for `kinds` serves spheres alone.
 constexpr bool spheres_only(uint32_t kinds) { return (kinds & ~(kLightSampling | kMicrofacet)) == kSpheresOnly; }
@@ -93,7 +98,9 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
           const TriangleGeom tri = g.triangle(prim);
           found = intersect_triangle(tri, ray.origin, tr, hit.t, t, b1, b2);
           // (The object-space ray: the same for every kernel.)
-          if (found && tri.alpha != 0u) found = alpha_lets_hit(g, tri.alpha, instance, prim, b1, b2, ray);
+          if ((Kinds & kAlphaTested) && found && tri.alpha != 0u) {
+            found = alpha_lets_hit(g, tri.alpha, instance, prim, b1, b2, ray);
+          }
         }
         break;
     }
@@ -108,7 +115,7 @@ WT_HD WT_INLINE void intersect_leaf(const Geometry& g, PrimitiveKind kind, int i
 //
 // AnyHit: return the first hit found (not the closest): enough to know that the
 // segment to tmax is blocked, which is what a shadow ray asks.
-template <uint32_t Kinds = kAllKinds, bool AnyHit = false, class Geometry>
+template <uint32_t Kinds = kAllKinds | kAlphaTested, bool AnyHit = false, class Geometry>
 WT_HD Hit intersect_closest(const Geometry& g, const Ray& world, float tmax) {
   Hit hit{tmax, -1, -1, 0.0f, 0.0f};
   if (g.node_count() == 0) return hit;
