@@ -54,8 +54,8 @@ constexpr bool spheres_only(uint32_t kinds) { return (kinds & ~(kLightSampling |
 // microfacet bit (host side): calls f with the set a kernel is compiled for, as a
 // std::integral_constant: spheres alone or all kinds, each with light sampling or
 // without, with the microfacet BSDFs or without. Kernels that never sample lights
-// or shade (intersect) say Lights = false and Microfacet = false and are compiled
-// twice, not eight times.
+// (intersect) say Lights = false and are compiled four times, not eight: they keep
+// the microfacet bit, which carries the alpha test (kAlphaTested).
 template <bool Lights = true, bool Microfacet = true, class F>
 inline void with_kinds(uint32_t scene_kinds, F&& f) {
   constexpr uint32_t kLights = Lights ? kLightSampling : 0u, kFacets = Microfacet ? kMicrofacet : 0u;
