@@ -52,7 +52,9 @@ inline Case material(const std::string& json, const std::string& textures = "") 
   return c;
 }
 
-// The BSDF of the case on the plane z = 0 (normals +z, tangent +x), seen from wo's side.
+// The BSDF of the case on the plane z = 0 (normals +z, tangent +x), seen from wo's
+// side; Layers = false: as a kernel without principled's layers makes it.
+template <bool Layers = true>
 inline BsdfAt at(const Case& c, const vec3& wo) {
   SurfacePoint sp{};
   sp.p = vec3(0.0f);
@@ -60,7 +62,7 @@ inline BsdfAt at(const Case& c, const vec3& wo) {
   sp.dpdu = vec3(1.0f, 0.0f, 0.0f);
   sp.front = wo.z > 0.0f;
   sp.offset = 1e-4f;
-  return bsdf_at(c.m, BsdfInputs{&c.p, c.tables.data(), c.textures.data(), nullptr}, sp, c.m.albedo, wo);
+  return bsdf_at<true, Layers>(c.m, BsdfInputs{&c.p, c.tables.data(), c.textures.data(), nullptr}, sp, c.m.albedo, wo);
 }
 
 // The incident direction at `deg` from the normal (azimuth 0.3 rad, so that

@@ -481,6 +481,8 @@ TEST_F(GltfAssets, AlphaMaskLetsEveryRayThroughCutOutTexelsAlike) {
   ASSERT_EQ(scene.alpha_tests.size(), 1u);
   EXPECT_EQ(scene.alpha_tests[0].mode, AlphaMode::Mask);
   EXPECT_FLOAT_EQ(scene.alpha_tests[0].cutoff, 0.5f);
+  // The kernels that test alpha are the ones with the layers and alpha.
+  EXPECT_EQ(scene.kernel_kinds() & (kAlphaTested | kMicrofacet), kAlphaTested | kMicrofacet);
   std::vector<ImageView> views;
   const SceneView view = host_view(scene, 8, 8, views);
   for (int ty = 0; ty < 4; ++ty) {
@@ -497,7 +499,9 @@ TEST_F(GltfAssets, AlphaMaskLetsEveryRayThroughCutOutTexelsAlike) {
   Doc opaque;
   opaque.j["materials"][0]["alphaMode"] = "MASK";
   opaque.j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {1, 1, 1, 0.5};
-  EXPECT_TRUE(scene_of(write("at-cutoff.gltf", opaque.gltf())).alpha_tests.empty());  // wholly there: no test
+  const Scene there = scene_of(write("at-cutoff.gltf", opaque.gltf()));
+  EXPECT_TRUE(there.alpha_tests.empty());  // wholly there: no test
+  EXPECT_FALSE(there.kernel_kinds() & kAlphaTested) << "an opaque glTF runs the kernels without alpha";
   opaque.j["materials"][0]["alphaCutoff"] = 0.6;
   const Scene gone = scene_of(write("below-cutoff.gltf", opaque.gltf()));
   ASSERT_EQ(gone.alpha_tests.size(), 1u);

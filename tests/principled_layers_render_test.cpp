@@ -4,8 +4,10 @@
 //   - clear volumes and thin walls of any roughness vanish under a uniform sky;
 //   - light sampling on and off converge to the same image on a scene of every
 //     layer, lit by a reflecting emitter;
-//   - the CPU's wavefront kernels equal its megakernel, and every CUDA kernel agrees
-//     with the CPU (the GPU suite).
+//   - the CPU's wavefront kernels equal its megakernel (which runs every feature) on
+//     a scene with the layers and on one without them, which the kernels without
+//     the layers serve, and every CUDA kernel agrees with the CPU on both (the GPU
+//     suite).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -121,15 +123,43 @@ TEST(PrincipledLayersRender, LightSamplingOnAndOffConvergeToTheSameImage) {
   test::expect_same_expectation(means(1), means(0), 0.03);
 }
 
+// The same spheres of principled materials without a coat or transmission: the
+// scene the kernels without the layers serve (kLayersAndAlpha).
+const Scene& layerless_scene() {
+  static const Scene scene = parse_scene(R"({
+    "camera": {"look_from": [0, 2.2, 6], "look_at": [0, 0.4, 0], "vfov": 40},
+    "sky": {"type": "uniform", "radiance": [0.3, 0.3, 0.35]},
+    "materials": [
+      {"name": "ground", "type": "principled", "albedo": [0.6, 0.6, 0.6], "roughness": 0.5},
+      {"name": "red", "type": "principled", "albedo": [0.8, 0.1, 0.1], "roughness": 0.6},
+      {"name": "tinted", "type": "principled", "albedo": [0.9, 0.8, 0.5], "roughness": 0.3, "specular_color": [1, 0.6, 0.3]},
+      {"name": "metal", "type": "principled", "albedo": [0.9, 0.7, 0.3], "metallic": 1, "roughness": 0.5},
+      {"name": "lamp", "type": "principled", "albedo": [0.5, 0.5, 0.5], "roughness": 0.4, "emission": [30, 28, 25]}],
+    "spheres": [
+      {"center": [0, -1000, 0], "radius": 1000, "material": "ground"},
+      {"center": [-1.2, 0.5, 0], "radius": 0.5, "material": "red"},
+      {"center": [0, 0.5, 0], "radius": 0.5, "material": "tinted"},
+      {"center": [1.2, 0.5, 0], "radius": 0.5, "material": "metal"},
+      {"center": [1.5, 4, 2], "radius": 0.4, "material": "lamp"}]})",
+                                         kSource);
+  return scene;
+}
+
+// The CPU's megakernel runs every feature; its wavefront, the kernels the scene
+// selects: with the layers for layers_scene, without them for layerless_scene.
 TEST(PrincipledLayersRender, CpuWavefrontKernelsMatchTheMegakernelToRounding) {
-  const RenderResult mega = render(layers_scene(), options_for(Backend::Cpu, Kernel::Megakernel, 48, 27, 8, 8, 3, 5));
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
-    const RenderResult wave = render(layers_scene(), options_for(Backend::Cpu, k, 48, 27, 8, 8, 3, 5));
-    ASSERT_EQ(wave.rgb.size(), mega.rgb.size());
-    for (size_t i = 0; i < mega.rgb.size(); ++i) {
-      ASSERT_NEAR(wave.rgb[i], mega.rgb[i], 1e-5f * (1.0f + std::fabs(mega.rgb[i]))) << kernel_name(k) << " " << i;
+  ASSERT_TRUE(layers_scene().kernel_kinds() & kLayersAndAlpha);
+  ASSERT_FALSE(layerless_scene().kernel_kinds() & kLayersAndAlpha);
+  for (const Scene* scene : {&layers_scene(), &layerless_scene()}) {
+    const RenderResult mega = render(*scene, options_for(Backend::Cpu, Kernel::Megakernel, 48, 27, 8, 8, 3, 5));
+    for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
+      const RenderResult wave = render(*scene, options_for(Backend::Cpu, k, 48, 27, 8, 8, 3, 5));
+      ASSERT_EQ(wave.rgb.size(), mega.rgb.size());
+      for (size_t i = 0; i < mega.rgb.size(); ++i) {
+        ASSERT_NEAR(wave.rgb[i], mega.rgb[i], 1e-5f * (1.0f + std::fabs(mega.rgb[i]))) << kernel_name(k) << " " << i;
+      }
+      EXPECT_EQ(wave.rays, mega.rays) << kernel_name(k);
     }
-    EXPECT_EQ(wave.rays, mega.rays) << kernel_name(k);
   }
 }
 
@@ -137,6 +167,9 @@ TEST(PrincipledLayersRender, EveryCudaKernelAgreesWithTheCpu) {
   WT_REQUIRE_CUDA();
   test::expect_cuda_agrees_with_cpu(
       [](Backend b, Kernel k, uint32_t seed) { return render(layers_scene(), options_for(b, k, 64, 36, 8, 8, 3, seed)); },
+      3);
+  test::expect_cuda_agrees_with_cpu(
+      [](Backend b, Kernel k, uint32_t seed) { return render(layerless_scene(), options_for(b, k, 64, 36, 8, 8, 3, seed)); },
       3);
 }
 

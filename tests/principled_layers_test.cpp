@@ -5,7 +5,9 @@
 // shares shown to fail, weight = eval / pdf, reciprocity, and the white furnace:
 // never more than arrives; a white thin wall and a white volume return or pass all
 // of it (within 1%); a white base under a full coat loses at most what the coat's
-// reciprocal weighting costs (principled.hpp).
+// reciprocal weighting costs (principled.hpp). The kernels without the layers
+// (geometry.hpp's kLayersAndAlpha) shade a principled material without them as the
+// kernels with them do, and the scenes that need the layers select them.
 #include <gtest/gtest.h>
 
 #include "bsdf_support.hpp"
@@ -242,6 +244,57 @@ TEST(PrincipledLayers, TexturedLayersAreTheValuesTheyScaleTo) {
     if (p_p > 0.0f) ++compared;
   }
   EXPECT_GT(compared, 1000);
+}
+
+// A kernel compiled without the layers leaves their code out: on a principled
+// material without a coat or transmission it samples and evaluates bit for bit as
+// one with them, and on a coated one it does not (so the scene must select the
+// layers' kernels: below).
+TEST(PrincipledLayers, KernelsWithoutTheLayersShadeALayerlessMaterialAlike) {
+  const char* const layerless[] = {
+      R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0.5})",
+      R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0.3, "metallic": 0.6})",
+      R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0.4, "specular_color": [1, 0.6, 0.3], "specular": 0.7})",
+      R"({"name": "m", "type": "principled", "albedo": [0.8, 0.5, 0.3], "roughness": 0, "metallic": 0.3})"};
+  auto same = [](const Case& c) {
+    int differ = 0;
+    for (double deg : kAngles) {
+      const vec3 wo = incident(deg);
+      const BsdfAt with = at<true>(c, wo), without = at<false>(c, wo);
+      for (uint32_t i = 0; i < 2000; ++i) {
+        const Rng rng = Rng::at(7, i, 0, 0);
+        const BsdfSample a = sample_bsdf<true, true>(with, wo, rng), b = sample_bsdf<true, false>(without, wo, rng);
+        float pa = 0.0f, pb = 0.0f;
+        const vec3 wi = a.lobe != 0u ? a.wi : -wo;
+        const vec3 fa = eval_bsdf<true, true>(with, wo, wi, pa), fb = eval_bsdf<true, false>(without, wo, wi, pb);
+        differ += a.lobe != b.lobe || a.wi != b.wi || a.weight != b.weight || a.pdf != b.pdf || fa != fb || pa != pb;
+      }
+    }
+    return differ;
+  };
+  for (const char* json : layerless) EXPECT_EQ(same(material(json)), 0) << json;
+  EXPECT_GT(same(material(kCoated[0])), 1000) << "a coat the kernel leaves out";
+  EXPECT_GT(same(material(kThin[0])), 1000) << "a thin wall the kernel leaves out";
+}
+
+TEST(PrincipledLayers, TheLayersAndAlphaSelectTheirKernels) {
+  auto kinds = [](const std::string& json) {
+    return parse_scene(R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]}, "materials": [)" + json + R"(],
+        "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})",
+                       "kinds.json")
+        .kernel_kinds();
+  };
+  const uint32_t plain = kinds(R"({"name": "m", "type": "principled", "roughness": 0.5, "metallic": 0.5})");
+  EXPECT_TRUE(plain & kMicrofacet);
+  EXPECT_FALSE(plain & kLayersAndAlpha) << "no coat, no transmission, no alpha";
+  EXPECT_FALSE(kinds(R"({"name": "m", "type": "plastic", "roughness": 0.5})") & kLayersAndAlpha);
+  for (const char* json : {kCoated[0], kThin[0], kVolume[0],
+                           R"({"name": "m", "type": "principled", "transmission": 1, "thin": false, "attenuation_color": [0.5, 1, 1], "attenuation_distance": 2})"}) {
+    const uint32_t k = kinds(json);
+    EXPECT_TRUE(k & kLayersAndAlpha) << json;
+    EXPECT_TRUE(k & kMicrofacet) << json;
+  }
+  EXPECT_FALSE(kinds(R"({"name": "m", "type": "principled", "clearcoat": 0, "transmission": 0})") & kLayersAndAlpha);
 }
 
 }  // namespace

@@ -31,12 +31,14 @@ struct BsdfInputs {
 };
 
 // Principled's textured coat (weight: red; roughness: green; its normal map) and
-// transmission (red), looked up where the material has them.
+// transmission (red), looked up where the material has them. Layers = false: a
+// kernel without principled's layers (kLayersAndAlpha), for scenes whose
+// materials have no coat and no transmission; they stay 0 there.
+template <bool Layers = true>
 WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const SurfacePoint& sp, const vec3& wo) {
   auto channel = [&](int32_t texture, int c) {
     return fminf(fmaxf(eval_texture(in.textures[texture], in.images, sp)[c], 0.0f), 1.0f);
   };
-  if (b.p.transmission_texture >= 0) b.p.transmission *= channel(b.p.transmission_texture, 0);
   if (b.p.specular_texture >= 0) {
     b.p.specular *= fminf(fmaxf(texture_alpha(in.textures[b.p.specular_texture], in.images,
                                               sp.has_uv ? sp.uv : sphere_uv(sp.n)),
@@ -46,6 +48,12 @@ WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const 
   if (b.p.specular_color_texture >= 0) {
     b.p.specular_color *= eval_texture(in.textures[b.p.specular_color_texture], in.images, sp);
   }
+  if constexpr (!Layers) {
+    b.p.transmission = 0.0f;
+    b.p.clearcoat = 0.0f;
+    return;
+  }
+  if (b.p.transmission_texture >= 0) b.p.transmission *= channel(b.p.transmission_texture, 0);
   if (!(b.p.clearcoat > 0.0f)) return;
   if (b.p.clearcoat_texture >= 0) b.p.clearcoat *= channel(b.p.clearcoat_texture, 0);
   if (b.p.coat_roughness_texture >= 0) {
@@ -63,7 +71,7 @@ WT_HD WT_INLINE void principled_textures(BsdfAt& b, const BsdfInputs& in, const 
 // (material_albedo). Where the material has parameters beyond the study's
 // (Microfacet kernels only): its textured roughness and normal map are looked up,
 // and the shading normal is turned to face wo (facing_viewer).
-template <bool Microfacet = true>
+template <bool Microfacet = true, bool Layers = Microfacet>
 WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const SurfacePoint& sp, const vec3& albedo,
                                const vec3& wo) {
   BsdfAt b;
@@ -107,15 +115,16 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
                             eval_texture(in.textures[b.p.normal_texture], in.images, sp), b.p.normal_strength);
       }
       b.n = facing_viewer(b.n, wo, b.front);
-      if (b.kind == MaterialKind::Principled) principled_textures(b, in, sp, wo);
+      if (b.kind == MaterialKind::Principled) principled_textures<Layers>(b, in, sp, wo);
     }
   }
   return b;
 }
 
 // Microfacet = false: compiled for scenes without the microfacet kinds (a kernel's
-// kMicrofacet bit), whose code it leaves out.
-template <bool Microfacet = true>
+// kMicrofacet bit), whose code it leaves out; Layers = false, for scenes without
+// principled's coat and transmission (kLayersAndAlpha).
+template <bool Microfacet = true, bool Layers = Microfacet>
 WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rng& rng) {
   switch (b.kind) {
     case MaterialKind::Lambertian: return lambertian_sample(b, wo, rng);
@@ -132,7 +141,7 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
       if constexpr (Microfacet) return plastic_sample(b, wo, rng);
       break;
     case MaterialKind::Principled:
-      if constexpr (Microfacet) return principled_sample(b, wo, rng);
+      if constexpr (Microfacet) return principled_sample<Layers>(b, wo, rng);
       break;
     case MaterialKind::Emissive: break;
   }
@@ -140,7 +149,7 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
 }
 
 // f cos for wi, and (in `pdf`) the density sample_bsdf draws it with.
-template <bool Microfacet = true>
+template <bool Microfacet = true, bool Layers = Microfacet>
 WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   pdf = 0.0f;
   vec3 f(0.0f);
@@ -170,7 +179,7 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
       if constexpr (Microfacet) f = plastic_eval(b, wo, wi, pdf);
       break;
     case MaterialKind::Principled:
-      if constexpr (Microfacet) f = principled_eval(b, wo, wi, pdf);
+      if constexpr (Microfacet) f = principled_eval<Layers>(b, wo, wi, pdf);
       break;
     case MaterialKind::Dielectric:
     case MaterialKind::Emissive: break;

@@ -11,8 +11,8 @@ namespace wt {
 constexpr float kRayTMax = 3.0e38f;
 
 // What the path functions are compiled for unless a kernel says otherwise: every
-// primitive kind, light sampling and the microfacet BSDFs.
-constexpr uint32_t kEverything = kAllKinds | kLightSampling | kMicrofacet;
+// primitive kind, light sampling, the microfacet BSDFs, principled's layers and alpha.
+constexpr uint32_t kEverything = kAllKinds | kLightSampling | kMicrofacet | kLayersAndAlpha;
 
 // Kinds: the primitive kinds the scene holds (geometry.hpp), or a superset.
 template <uint32_t Kinds = kAllKinds | kAlphaTested, class Scene>
@@ -170,7 +170,7 @@ WT_HD WT_INLINE ShadowRay sample_light(const Scene& scene, const RenderParams& r
     light_pdf = light_density(scene, lm.emission, shape, out.ray.origin, out.ray.dir, length);
   }
   float bsdf_pdf;
-  vec3 f_cos = eval_bsdf<(Kinds & kMicrofacet) != 0>(bsdf, wo, out.ray.dir, bsdf_pdf);
+  vec3 f_cos = eval_bsdf<(Kinds & kMicrofacet) != 0, (Kinds & kLayersAndAlpha) != 0>(bsdf, wo, out.ray.dir, bsdf_pdf);
   if (!(bsdf_pdf > 0.0f) || !(light_pdf > 0.0f)) return out;
   if (WT_MUTANT(MissingCosine)) f_cos *= 1.0f / fmaxf(fabsf(glm::dot(out.ray.dir, bsdf.facing_n())), 1e-3f);
   // A delta light's sample has no rival strategy: its weight is 1.
@@ -193,6 +193,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   const Material& m = scene.material(material_index<Kinds>(scene, hit));
   const bool nee = (Kinds & kLightSampling) != 0 && rp.nee != 0 && scene.light_count() > 0;
   constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
+  constexpr bool kLayers = kFacets && (Kinds & kLayersAndAlpha) != 0;
   // An emitter adds what it sends out (a reflecting one, kMaterialEmits, then
   // scatters too).
   if (m.kind == MaterialKind::Emissive || (kFacets && (m.flags & kMaterialEmits))) {
@@ -208,7 +209,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   // A path that meets a volume's boundary from inside crossed the volume to it:
   // Beer-Lambert's absorption over the distance (KHR_materials_volume; a closed
   // surface, volumes not nested).
-  if constexpr (kFacets) {
+  if constexpr (kLayers) {
     if (m.params >= 0 && !sp.front) {
       const vec3 sigma = scene.material_param_array()[m.params].attenuation;
       if (sigma.x > 0.0f || sigma.y > 0.0f || sigma.z > 0.0f) {
@@ -222,7 +223,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   }
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 wo = -ray.dir;
-  const BsdfAt bsdf = bsdf_at<kFacets>(
+  const BsdfAt bsdf = bsdf_at<kFacets, kLayers>(
       m, BsdfInputs{scene.material_param_array(), scene.bsdf_table_array(), scene.texture_array(), scene.image_array()},
       sp, material_albedo<kFacets>(m, scene.texture_array(), scene.image_array(), sp), wo);
   // A light sample here stands for the path's next ray hitting the emitter, so it
@@ -233,7 +234,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
   if ((nee || punctual) && bsdf_samples_lights<kFacets>(bsdf) && static_cast<int>(bounce) + 1 < rp.depth) {
     shadow = sample_light<Kinds>(scene, rp, bsdf, sp, wo, throughput, rng);
   }
-  const BsdfSample s = sample_bsdf<kFacets>(bsdf, wo, rng);
+  const BsdfSample s = sample_bsdf<kFacets, kLayers>(bsdf, wo, rng);
   if (s.lobe == 0u) return false;
   const Ray next = spawn_ray(sp, s.wi);
   // The density of the direction the path goes on in, for the MIS weight of what it

@@ -104,9 +104,10 @@ struct Scene {
   Summary summary() const;
   // The primitive kinds the scene places (geometry.hpp's bits).
   uint32_t primitive_kinds() const;
-  // The primitive kinds, and kMicrofacet where a material has parameters beyond the
-  // study's (the microfacet kinds, normal maps): the kernel the scene needs
-  // (geometry.hpp's with_kinds).
+  // The primitive kinds, kMicrofacet where a material has parameters beyond the
+  // study's (the microfacet kinds, normal maps), and kLayersAndAlpha where a
+  // triangle is alpha-tested or a principled material has a coat, transmission or a
+  // volume: the kernel the scene needs (geometry.hpp's with_kinds).
   uint32_t kernel_kinds() const;
   // What the scene's arrays and images take on the device.
   size_t device_bytes() const;

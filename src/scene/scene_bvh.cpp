@@ -331,9 +331,16 @@ uint32_t Scene::kernel_kinds() const {
   // The microfacet kinds, any material with parameters beyond the study's (a
   // normal map), a mip-mapped image texture and a textured emitter need the kernels
   // that read them.
-  if (!alpha_tests.empty()) kinds |= kAlphaTested;
+  // Alpha-tested triangles, principled's coat, transmission and volume need the
+  // kernels with the layers and alpha, which come with the microfacet ones.
+  if (!alpha_tests.empty()) kinds |= kLayersAndAlpha | kMicrofacet;
   for (const Material& m : materials) {
     if (m.params >= 0) kinds |= kMicrofacet;
+    if (m.params >= 0 && static_cast<size_t>(m.params) < material_params.size()) {
+      const MaterialParams& p = material_params[static_cast<size_t>(m.params)];
+      const bool absorbs = p.attenuation.x > 0.0f || p.attenuation.y > 0.0f || p.attenuation.z > 0.0f;
+      if (p.clearcoat > 0.0f || p.transmission > 0.0f || absorbs) kinds |= kLayersAndAlpha;
+    }
     if (m.texture >= 0 && static_cast<size_t>(m.texture) < textures.size()) {
       const Texture& t = textures[static_cast<size_t>(m.texture)];
       if (m.kind == MaterialKind::Emissive || (t.kind == TextureKind::Image && t.filter == Filter::Trilinear)) {

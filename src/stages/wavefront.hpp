@@ -144,9 +144,9 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         ++blocks;
       }
       for (int cur = 0;; cur = 1 - cur) {
-        // (With the microfacet bit where the scene has it: alpha tests are compiled
-        // into those kernels alone, geometry.hpp's kAlphaTested.)
-        with_kinds<false, true>(scene.kinds, [&](auto kinds) {
+        // (With the alpha bit where the scene has alpha-tested triangles:
+        // geometry.hpp's kAlphaTested.)
+        with_kinds<false, false, true>(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
                     IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, limit, first,
                                            slots, film});

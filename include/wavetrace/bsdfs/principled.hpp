@@ -151,8 +151,21 @@ WT_HD WT_INLINE float principled_coat_albedo(const BsdfAt& b, const Ggx& gc, flo
   return layer_albedo(b, b.p.coat_table, kCoatF0, b.p.clearcoat, gc, mu);
 }
 
+// The coat's weight and the transmission, as a kernel compiled with principled's
+// layers (Layers, the kLayersAndAlpha bit) or without them (0: their code is left
+// out; such a kernel serves scenes without them) reads them.
+template <bool Layers>
+WT_HD WT_INLINE float principled_clearcoat(const BsdfAt& b) {
+  return Layers ? b.p.clearcoat : 0.0f;
+}
+template <bool Layers>
+WT_HD WT_INLINE float principled_transmission(const BsdfAt& b) {
+  return Layers ? b.p.transmission : 0.0f;
+}
+
+template <bool Layers = true>
 WT_HD WT_INLINE bool principled_thick(const BsdfAt& b) {
-  return b.p.transmission > 0.0f && !(b.flags & kMaterialThin);
+  return principled_transmission<Layers>(b) > 0.0f && !(b.flags & kMaterialThin);
 }
 
 // The coat's shading frame on wo's side.
@@ -167,15 +180,16 @@ struct PrincipledLobes {
   float coat, glossy, diffuse, transmit;
 };
 
+template <bool Layers = true>
 WT_HD WT_INLINE PrincipledLobes principled_lobes(const BsdfAt& b, const Ggx& g, const Ggx& gc, float mu_o, float mu_oc) {
-  const float m = b.p.metallic, t = b.p.transmission;
+  const float m = b.p.metallic, t = principled_transmission<Layers>(b);
   const vec3 layer = principled_layer_albedo(b, g, mu_o);
   const float fd = (layer.x + layer.y + layer.z) * (1.0f / 3.0f);
   const vec3 fm = schlick_f0(mu_o, b.albedo);
   const float mean = (b.albedo.x + b.albedo.y + b.albedo.z) * (1.0f / 3.0f);
-  const float coat = b.p.clearcoat > 0.0f ? principled_coat_albedo(b, gc, mu_oc) : 0.0f;
+  const float coat = principled_clearcoat<Layers>(b) > 0.0f ? principled_coat_albedo(b, gc, mu_oc) : 0.0f;
   const float through = 1.0f - coat;
-  const bool thick = principled_thick(b);
+  const bool thick = principled_thick<Layers>(b);
   PrincipledLobes l;
   l.coat = coat;
   l.glossy = through * ((1.0f - m) * (thick ? 1.0f - t : 1.0f) * fd + m * (fm.x + fm.y + fm.z) * (1.0f / 3.0f));
@@ -211,23 +225,24 @@ WT_HD WT_INLINE vec3 principled_thin_local(const BsdfAt& b, const Ggx& g, const 
 }
 
 // f cos and the density of every lobe that is not a delta, for world directions.
+template <bool Layers = true>
 WT_HD WT_INLINE vec3 principled_eval_all(const BsdfAt& b, const vec3& wo_world, const vec3& wi_world, float& pdf) {
   pdf = 0.0f;
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world), wi = fr.to_local(wi_world);
   if (wo.z <= 0.0f || wi.z == 0.0f) return vec3(0.0f);
   const Ggx g = principled_ggx(b), gc = principled_coat_ggx(b);
-  const float m = b.p.metallic, t = b.p.transmission;
+  const float m = b.p.metallic, t = principled_transmission<Layers>(b);
   vec3 f(0.0f);
   // The coat: its lobe, and what it lets through.
   float through = 1.0f;
   float mu_oc = wo.z;
   PrincipledLobes l;
-  if (b.p.clearcoat > 0.0f) {
+  if (principled_clearcoat<Layers>(b) > 0.0f) {
     const Frame fc = principled_coat_frame(b);
     const vec3 co = fc.to_local(wo_world), ci = fc.to_local(wi_world);
     mu_oc = fmaxf(co.z, 0.0f);
-    l = principled_lobes(b, g, gc, wo.z, mu_oc);
+    l = principled_lobes<Layers>(b, g, gc, wo.z, mu_oc);
     through = fminf(1.0f - principled_coat_albedo(b, gc, mu_oc), 1.0f - principled_coat_albedo(b, gc, fabsf(ci.z)));
     if (!gc.smooth() && co.z > 0.0f && ci.z > 0.0f) {
       const ConductorLobe coat = principled_lobe(b, vec3(kCoatF0));
@@ -235,9 +250,9 @@ WT_HD WT_INLINE vec3 principled_eval_all(const BsdfAt& b, const vec3& wo_world, 
       pdf += l.coat * conductor_pdf_local(coat, gc, co, ci);
     }
   } else {
-    l = principled_lobes(b, g, gc, wo.z, mu_oc);
+    l = principled_lobes<Layers>(b, g, gc, wo.z, mu_oc);
   }
-  const bool thick = principled_thick(b);
+  const bool thick = principled_thick<Layers>(b);
   const ConductorLobe metal = principled_lobe(b, b.albedo);
   if (wi.z > 0.0f) {
     const vec3 layer = (vec3(1.0f) - principled_layer_albedo(b, g, wo.z)) *
@@ -275,18 +290,19 @@ WT_HD WT_INLINE bool principled_culled(const BsdfAt& b) {
   return (b.flags & kMaterialOneSided) && !b.front && !(b.p.transmission > 0.0f);
 }
 
+template <bool Layers = true>
 WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_world, const Rng& rng) {
   if (principled_culled(b)) return no_sample();
   const Frame fr = b.facing_frame();
   const vec3 wo = fr.to_local(wo_world);
   if (wo.z <= 0.0f) return no_sample();
   const Ggx g = principled_ggx(b), gc = principled_coat_ggx(b);
-  const bool coated = b.p.clearcoat > 0.0f;
+  const bool coated = principled_clearcoat<Layers>(b) > 0.0f;
   const Frame fc = coated ? principled_coat_frame(b) : fr;
   const vec3 co = coated ? fc.to_local(wo_world) : wo;
-  const PrincipledLobes l = principled_lobes(b, g, gc, wo.z, fmaxf(co.z, 0.0f));
-  const float m = b.p.metallic, t = b.p.transmission;
-  const bool thick = principled_thick(b);
+  const PrincipledLobes l = principled_lobes<Layers>(b, g, gc, wo.z, fmaxf(co.z, 0.0f));
+  const float m = b.p.metallic, t = principled_transmission<Layers>(b);
+  const bool thick = principled_thick<Layers>(b);
   // What the coat lets through for wi (a delta's weight needs it).
   auto through = [&](const vec3& wi_world) {
     if (!coated) return 1.0f;
@@ -346,17 +362,18 @@ WT_HD WT_INLINE BsdfSample principled_sample(const BsdfAt& b, const vec3& wo_wor
   }
   if (b.same_side(wi_world) != ((lobe & kLobeReflection) != 0)) return no_sample();
   float pdf;
-  const vec3 f = principled_eval_all(b, wo_world, wi_world, pdf);
+  const vec3 f = principled_eval_all<Layers>(b, wo_world, wi_world, pdf);
   if (!(pdf > 0.0f)) return no_sample();
   return BsdfSample{wi_world, f * (1.0f / pdf), pdf, lobe};
 }
 
+template <bool Layers = true>
 WT_HD WT_INLINE vec3 principled_eval(const BsdfAt& b, const vec3& wo, const vec3& wi, float& pdf) {
   pdf = 0.0f;
   if (principled_culled(b)) return vec3(0.0f);
   // A transmitting surface: reflection stays on wo's side of the geometric surface,
   // transmission crosses it (as the sampler keeps them).
-  if (b.p.transmission > 0.0f && b.same_side(wi) != (glm::dot(wi, b.facing_n()) > 0.0f)) return vec3(0.0f);
+  if (principled_transmission<Layers>(b) > 0.0f && b.same_side(wi) != (glm::dot(wi, b.facing_n()) > 0.0f)) return vec3(0.0f);
   return principled_eval_all(b, wo, wi, pdf);
 }
 

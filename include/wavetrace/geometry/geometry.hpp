@@ -41,36 +41,52 @@ constexpr uint32_t kLightSampling = 1u << 31;
 // megakernel 5% on seed57 for the BSDFs, and half its speed with the textures, in
 // registers and instructions it never runs.
 constexpr uint32_t kMicrofacet = 1u << 30;
-// Alpha-tested triangles (glTF's MASK and BLEND) are tested in the traversal of the
-// kernels with the features beyond the study's alone, which a scene with alpha
-// selects (Scene::kernel_kinds): compiled into every kernel, the test slowed the
-// megakernel on the study's opaque Cornell box by 18%.
-constexpr uint32_t kAlphaTested = kMicrofacet;
+// Not a primitive kind either: a kernel compiled with the features of authored
+// assets past the microfacet BSDFs: alpha-tested triangles (glTF's MASK and BLEND)
+// in the traversal, and principled's clear coat, transmission and volume in the
+// shading. A scene selects it only when it holds one of them (Scene::kernel_kinds),
+// and then always with kMicrofacet: compiled into every microfacet kernel, the
+// alpha test and the layers slowed materials.json's megakernel (which has neither)
+// by 18%, in spills of registers its paths never use.
+constexpr uint32_t kLayersAndAlpha = 1u << 29;
+constexpr uint32_t kAlphaTested = kLayersAndAlpha;
 
 // Whether a kernel compiled for `kinds` serves spheres alone.
-constexpr bool spheres_only(uint32_t kinds) { return (kinds & ~(kLightSampling | kMicrofacet)) == kSpheresOnly; }
+constexpr bool spheres_only(uint32_t kinds) {
+  return (kinds & ~(kLightSampling | kMicrofacet | kLayersAndAlpha)) == kSpheresOnly;
+}
 
-// The one choice of kernel by a scene's kinds, light sampling's bit and the
-// microfacet bit (host side): calls f with the set a kernel is compiled for, as a
-// std::integral_constant: spheres alone or all kinds, each with light sampling or
-// without, with the microfacet BSDFs or without. Kernels that never sample lights
-// (intersect) say Lights = false and are compiled four times, not eight: they keep
-// the microfacet bit, which carries the alpha test (kAlphaTested).
-template <bool Lights = true, bool Microfacet = true, class F>
+// The one choice of kernel by a scene's kinds and its feature bits (host side):
+// calls f with the set a kernel is compiled for, as a std::integral_constant:
+// spheres alone or all kinds; with light sampling or without; with the study's
+// materials alone, the microfacet BSDFs, or those with the layers and alpha. A
+// kernel that never samples lights or shades (intersect) says Lights = false and
+// Microfacet = false, and is compiled four times (primitives, alpha or not), not
+// twelve. A scene's layers-and-alpha bit comes with its microfacet bit, so kernels
+// with both template flags never compile layers without the microfacet BSDFs.
+template <bool Lights = true, bool Microfacet = true, bool Layers = true, class F>
 inline void with_kinds(uint32_t scene_kinds, F&& f) {
   constexpr uint32_t kLights = Lights ? kLightSampling : 0u, kFacets = Microfacet ? kMicrofacet : 0u;
+  constexpr uint32_t kLayers = Layers ? kLayersAndAlpha : 0u;
   const bool lights = Lights && (scene_kinds & kLightSampling) != 0;
-  const bool facets = Microfacet && (scene_kinds & kMicrofacet) != 0;
+  const bool layers = Layers && (scene_kinds & kLayersAndAlpha) != 0;
+  const bool facets = Microfacet && (scene_kinds & (kMicrofacet | kLayersAndAlpha)) != 0;
   auto with_flags = [&](auto primitives) {
     constexpr uint32_t p = decltype(primitives)::value;
-    if (lights && facets) {
-      f(std::integral_constant<uint32_t, p | kLights | kFacets>{});
-    } else if (lights) {
-      f(std::integral_constant<uint32_t, p | kLights>{});
+    auto with_lights = [&](auto features) {
+      constexpr uint32_t q = p | decltype(features)::value;
+      if (lights) {
+        f(std::integral_constant<uint32_t, q | kLights>{});
+      } else {
+        f(std::integral_constant<uint32_t, q>{});
+      }
+    };
+    if (layers) {
+      with_lights(std::integral_constant<uint32_t, kFacets | kLayers>{});
     } else if (facets) {
-      f(std::integral_constant<uint32_t, p | kFacets>{});
+      with_lights(std::integral_constant<uint32_t, kFacets>{});
     } else {
-      f(std::integral_constant<uint32_t, p>{});
+      with_lights(std::integral_constant<uint32_t, 0u>{});
     }
   };
   if (spheres_only(scene_kinds)) {
