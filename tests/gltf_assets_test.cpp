@@ -280,6 +280,33 @@ TEST_F(GltfAssets, TextureTransformMovesATexelWhereExpected) {
   expect_error(write("bad-transform.gltf", bad.gltf()), "KHR_texture_transform scale must be 2 numbers");
 }
 
+// One texture read for two parameters (the coat's strength and roughness, as
+// glTF's sample assets pack them) is one lookup; the same image under another
+// KHR_texture_transform is a texture of its own, moved as its transform says.
+TEST_F(GltfAssets, OneImageUnderTwoTransformsIsTwoTextures) {
+  write("marked.png", marked_png());
+  for (const bool same : {true, false}) {
+    json roughness = {{"index", 0}};
+    if (!same) roughness["extensions"] = {{"KHR_texture_transform", {{"offset", {0.25, 0}}}}};
+    Doc d;
+    d.base_colour({{"uri", "marked.png"}});
+    d.j["materials"][0]["extensions"]["KHR_materials_clearcoat"] = {
+        {"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 0}}}, {"clearcoatRoughnessTexture", roughness}};
+    const Scene scene = scene_of(write("coat.gltf", d.gltf()));
+    const MaterialParams& p = scene.material_params.at(scene.materials.at(0).params);
+    ASSERT_GE(p.clearcoat_texture, 0);
+    ASSERT_GE(p.coat_roughness_texture, 0);
+    EXPECT_EQ(p.coat_roughness_texture == p.clearcoat_texture, same);
+    EXPECT_EQ(scene.textures.size(), same ? 2u : 3u);  // the base colour's, and the coat's one or two
+    if (!same) {
+      const vec2 centre(1.5f / 4, 2.5f / 4);  // the red texel's centre
+      EXPECT_TRUE(is_red(lookup(scene, p.clearcoat_texture, centre)));
+      EXPECT_TRUE(is_red(lookup(scene, p.coat_roughness_texture, centre - vec2(0.25f, 0.0f))));
+      EXPECT_FALSE(is_red(lookup(scene, p.coat_roughness_texture, centre)));
+    }
+  }
+}
+
 // A material whose textures name texCoord 1 (or whose transform does) has the
 // mesh's TEXCOORD_1 as its UVs; one naming a set the primitive lacks is refused.
 TEST_F(GltfAssets, TexCoord1IsReadWhereTheTexturesNameIt) {

@@ -30,6 +30,11 @@ struct MeshTexture {
   vec2 uv_offset{0.0f}, uv_scale{1.0f};
   float uv_rotation = 0.0f;  // radians
   bool empty() const { return image.empty(); }
+  // The same image read the same way (wrap, filters, transform).
+  bool same_lookup(const MeshTexture& o) const {
+    return image == o.image && wrap_u == o.wrap_u && wrap_v == o.wrap_v && filter == o.filter &&
+           magnify == o.magnify && uv_offset == o.uv_offset && uv_scale == o.uv_scale && uv_rotation == o.uv_rotation;
+  }
 };
 
 // One of the file's materials, mapped onto a wavetrace Material.

@@ -97,6 +97,12 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         scene_.textures.push_back(t);
         return static_cast<int32_t>(scene_.textures.size() - 1);
       };
+      // A linear map read as another already is (glTF's metallic with its roughness,
+      // a coat's roughness with its strength) is that texture, which bsdf_at then
+      // looks up once; the same image under another transform or sampler is its own.
+      auto shared_or_new = [&](const MeshTexture& mt, const MeshTexture& other, int32_t other_texture) {
+        return other_texture >= 0 && mt.same_lookup(other) ? other_texture : texture_of(mt, false);
+      };
       if (!mm.albedo_map.empty()) {
         m.texture = texture_of(mm.albedo_map, true);
         m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, static_cast<int>(TextureKind::Image)));
@@ -116,9 +122,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
                                                      mm.attenuation_distance});
         if (!mm.clearcoat_map.empty()) p.clearcoat_texture = texture_of(mm.clearcoat_map, false);
         if (!mm.clearcoat_roughness_map.empty()) {
-          p.coat_roughness_texture = mm.clearcoat_roughness_map.image == mm.clearcoat_map.image && p.clearcoat_texture >= 0
-                                         ? p.clearcoat_texture
-                                         : texture_of(mm.clearcoat_roughness_map, false);
+          p.coat_roughness_texture = shared_or_new(mm.clearcoat_roughness_map, mm.clearcoat_map, p.clearcoat_texture);
         }
         if (!mm.clearcoat_normal_map.empty()) p.coat_normal_texture = texture_of(mm.clearcoat_normal_map, false);
         if (!mm.transmission_map.empty()) p.transmission_texture = texture_of(mm.transmission_map, false);
@@ -128,10 +132,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         if (!mm.specular_color_map.empty()) p.specular_color_texture = texture_of(mm.specular_color_map, true);
         if (!mm.roughness_map.empty()) p.roughness_texture = texture_of(mm.roughness_map, false);
         if (!mm.metallic_map.empty()) {
-          // glTF's one texture for both is looked up once (bsdf_at).
-          p.metallic_texture = mm.metallic_map.image == mm.roughness_map.image && p.roughness_texture >= 0
-                                   ? p.roughness_texture
-                                   : texture_of(mm.metallic_map, false);
+          p.metallic_texture = shared_or_new(mm.metallic_map, mm.roughness_map, p.roughness_texture);
         }
         if (!mm.normal_map.empty()) p.normal_texture = texture_of(mm.normal_map, false);
         prepare_microfacet(m, p, scene_.bsdf_tables, shared_tables_);
