@@ -1290,6 +1290,9 @@ class Converter:
             # ray), and its conductors and plastics either side of any surface;
             # Mitsuba's BSDFs are one-sided unless wrapped.
             b = {"type": "twosided", "bsdf": b}
+        if "bump_texture" in m:
+            self.notes.add("bump_texture '%s' of '%s': not converted (the peer's surface is not bumped; Mitsuba's "
+                           "bumpmap, not emitted, displaces by the same scale x height)" % (m["bump_texture"], m["name"]))
         return self.alpha(m, self.normal_map(m, b, on_sphere), on_sphere)
 
     def channel(self, t, channel, scale, on_sphere, to_object, what, cutoff=None):

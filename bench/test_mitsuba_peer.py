@@ -995,6 +995,11 @@ class TexturedMaterialTest(Base):
         with self.assertRaisesRegex(mp.ConversionError, "colorspace"):
             self.bsdfs([{"name": "s", "type": "lambertian", "normal_texture": "map_srgb"}])
 
+    def test_a_bump_map_is_named_as_not_converted(self):
+        conv, b = self.bsdfs([{"name": "l", "type": "lambertian", "bump_texture": "map", "bump_scale": 0.1}])
+        self.assertEqual(b[0]["type"], "diffuse")                       # as it is, unbumped
+        self.assertIn("bump_texture 'map' of 'l': not converted", " ".join(conv.notes))
+
     def test_normal_map_on_a_mesh(self):
         conv = mp.convert(os.path.join(ROOT, "scenes", "materials-single.json"))
         maps = [v for v in conv.scene.values() if isinstance(v, dict) and v.get("type") == "normalmap"]

@@ -8,10 +8,13 @@
 //     kernel agrees with the CPU (the GPU suite).
 #include <gtest/gtest.h>
 
+#include <stb/stb_image_write.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "render_support.hpp"
@@ -284,54 +287,38 @@ TEST(MaterialRender, CpuWavefrontKernelsMatchTheMegakernelToRounding) {
   }
 }
 
-// A flat quad whose constant normal map tilts its normal by 30 degrees lights as
-// the quad tilted by 30 degrees does: under one far lamp (black sky, direct light
-// only), the mean over the middle of the image (symmetric about the centre, so that
-// the tilt's change of distance to the lamp cancels to first order) agrees, 16
-// seeds each within 4 standard errors (at most 1% of the value). Once about the
-// v axis (the map's red channel: the tangent, dp/du, is +x) and once about the u
-// axis (green: up the image, which the OBJ's v runs along -z), so that both axes
-// and the bitangent's handedness are held. The map is a checker of one colour: a
-// constant texture with no quantisation.
-TEST(MaterialRender, AConstantTiltedNormalMapLightsLikeTheTiltedQuad) {
-  test::TestFolder folder;
-  {
-    // u along +x, the file's v along -z: v = 0 at z = +1 is the image's bottom row.
+// A flat quad (u along +x, the OBJ's v along -z: v = 0 at z = +1 is the image's
+// bottom row) under one far lamp, black sky, direct light only, seen from above;
+// the mean over the middle of the image (symmetric about the centre, so that a
+// tilt's change of distance to the lamp cancels to first order) of 16 seeds. A
+// quad whose map tilts its shading normal lights as the quad tilted by the same
+// rotation: each within 4 standard errors (at most 1% of the value), and the
+// untilted quad otherwise (the test sees the map).
+class TiltedQuad {
+ public:
+  TiltedQuad() {
     std::ofstream obj(folder.root() / "quad.obj");
     obj << "v -1 0 1\nv 1 0 1\nv 1 0 -1\nv -1 0 -1\n"
            "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 1 0\n"
            "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
   }
-  const float s = 0.5f, c = std::sqrt(3.0f) / 2.0f;  // sin, cos 30 degrees
-  struct Case {
-    const char* what;
-    vec3 map;             // the tangent-space normal
-    const char* matrix;   // the rotation that tilts +y to the same world normal
-  };
-  // +y to (s, c, 0): about z by -30 degrees; +y to (0, c, -s): about x by -30 degrees.
-  const std::string cz = std::to_string(c), sz = std::to_string(s);
-  const std::string about_z = "[" + cz + ", " + sz + ", 0, 0,  -" + sz + ", " + cz + ", 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]";
-  const std::string about_x = "[1, 0, 0, 0,  0, " + cz + ", " + sz + ", 0,  0, -" + sz + ", " + cz + ", 0,  0, 0, 0, 1]";
-  for (const auto& [what, map, matrix] : {std::tuple<const char*, vec3, std::string>{"red: along u", vec3(s, 0, c), about_z},
-                                          std::tuple<const char*, vec3, std::string>{"green: up the image", vec3(0, s, c), about_x}}) {
-    const vec3 colour = 0.5f * (map + vec3(1.0f));
-    const std::string rgb = "[" + std::to_string(colour.x) + ", " + std::to_string(colour.y) + ", " +
-                            std::to_string(colour.z) + "]";
-    const std::string identity = "[1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]";
-    auto scene = [&](bool mapped, const std::string& placement) {
-      const std::string doc = R"({"camera": {"look_from": [0, 6, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "vfov": 24},
-        "sky": {"type": "uniform", "radiance": [0, 0, 0]},
-        "textures": [{"name": "n", "type": "checker", "size": 1, "even": )" + rgb + R"(, "odd": )" + rgb + R"(}],
-        "materials": [{"name": "m", "type": "lambertian", "albedo": [0.8, 0.8, 0.8])" +
-                              std::string(mapped ? R"(, "normal_texture": "n")" : "") + R"(},
-                      {"name": "lamp", "type": "emissive", "emission": [4000, 4000, 4000]}],
-        "meshes": [{"name": "quad", "file": "quad.obj"}],
-        "instances": [{"mesh": "quad", "material": "m", "matrix": )" + placement + R"(}],
-        "spheres": [{"center": [30, 50, 20], "radius": 1, "material": "lamp"}]})";
-      return parse_scene(doc, (folder.root() / "scene.json").string());
-    };
-    const Scene flat = scene(true, identity), tilted = scene(false, matrix), plain = scene(false, identity);
-    ASSERT_TRUE(flat.kernel_kinds() & kMicrofacet) << "a normal map needs the kernels that read it";
+  // `textures`: the scene's texture list; `mapped`: the material's map keys.
+  Scene scene(const std::string& textures, const std::string& mapped, const std::string& placement) const {
+    const std::string doc = R"({"camera": {"look_from": [0, 6, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "vfov": 24},
+      "sky": {"type": "uniform", "radiance": [0, 0, 0]},
+      "textures": [)" + textures + R"(],
+      "materials": [{"name": "m", "type": "lambertian", "albedo": [0.8, 0.8, 0.8])" + mapped + R"(},
+                    {"name": "lamp", "type": "emissive", "emission": [4000, 4000, 4000]}],
+      "meshes": [{"name": "quad", "file": "quad.obj"}],
+      "instances": [{"mesh": "quad", "material": "m", "matrix": )" + placement + R"(}],
+      "spheres": [{"center": [30, 50, 20], "radius": 1, "material": "lamp"}]})";
+    return parse_scene(doc, (folder.root() / "scene.json").string());
+  }
+  void expect_lights_like_tilted(const std::string& textures, const std::string& mapped,
+                                 const std::string& matrix) const {
+    const Scene flat = scene(textures, mapped, kIdentity), tilted = scene(textures, "", matrix),
+                plain = scene(textures, "", kIdentity);
+    ASSERT_TRUE(flat.kernel_kinds() & kMicrofacet) << "a map needs the kernels that read it";
     auto middle = [](const Scene& sc, uint32_t seed) {
       const RenderResult r = render(sc, options_for(Backend::Cpu, Kernel::Megakernel, 32, 32, 16, 2, 8, seed));
       double sum = 0;
@@ -346,13 +333,127 @@ TEST(MaterialRender, AConstantTiltedNormalMapLightsLikeTheTiltedQuad) {
       b.push_back(middle(tilted, seed));
       p.push_back(middle(plain, seed));
     }
-    SCOPED_TRACE(what);
     const double lit = test::mean_and_standard_error(b).mean;
     EXPECT_GT(lit, 1e-3) << "the lamp should light the quad";
     test::expect_same_expectation(a, b, 0.01);
-    // The untilted quad lights otherwise (by 16% and 34%): the test sees the map.
     EXPECT_GT(std::fabs(test::mean_and_standard_error(p).mean - lit), 0.1 * lit);
   }
+  static constexpr const char* kIdentity = "[1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]";
+  // Rotations by 30 degrees that tilt +y to (s, c, 0), (-s, c, 0) and (0, c, -s).
+  static std::string tilt_to_plus_x() { return rotation("[C, S, 0, 0,  -S, C, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]"); }
+  static std::string tilt_to_minus_x() { return rotation("[C, -S, 0, 0,  S, C, 0, 0,  0, 0, 1, 0,  0, 0, 0, 1]"); }
+  static std::string tilt_to_minus_z() { return rotation("[1, 0, 0, 0,  0, C, S, 0,  0, -S, C, 0,  0, 0, 0, 1]"); }
+  test::TestFolder folder;
+
+ private:
+  static std::string rotation(std::string m) {
+    const std::string c = std::to_string(std::sqrt(3.0f) / 2.0f), s = std::to_string(0.5f);
+    for (size_t at; (at = m.find('C')) != std::string::npos;) m.replace(at, 1, c);
+    for (size_t at; (at = m.find('S')) != std::string::npos;) m.replace(at, 1, s);
+    return m;
+  }
+};
+
+// A constant normal map tilting the normal by 30 degrees: once about the v axis
+// (the map's red channel: the tangent, dp/du, is +x) and once about the u axis
+// (green: up the image, which the OBJ's v runs along -z), so that both axes and the
+// bitangent's handedness are held. The map is a checker of one colour: a constant
+// texture with no quantisation.
+TEST(MaterialRender, AConstantTiltedNormalMapLightsLikeTheTiltedQuad) {
+  const TiltedQuad quad;
+  const float s = 0.5f, c = std::sqrt(3.0f) / 2.0f;  // sin, cos 30 degrees
+  for (const auto& [what, map, matrix] :
+       {std::tuple<const char*, vec3, std::string>{"red: along u", vec3(s, 0, c), TiltedQuad::tilt_to_plus_x()},
+        std::tuple<const char*, vec3, std::string>{"green: up the image", vec3(0, s, c), TiltedQuad::tilt_to_minus_z()}}) {
+    SCOPED_TRACE(what);
+    const vec3 colour = 0.5f * (map + vec3(1.0f));
+    const std::string rgb = "[" + std::to_string(colour.x) + ", " + std::to_string(colour.y) + ", " +
+                            std::to_string(colour.z) + "]";
+    quad.expect_lights_like_tilted(R"({"name": "n", "type": "checker", "size": 1, "even": )" + rgb + R"(, "odd": )" +
+                                       rgb + "}",
+                                   R"(, "normal_texture": "n")", matrix);
+  }
+}
+
+// A bump map whose heights rise linearly tilts the normal away from the rise: a
+// 16-texel grey ramp of 8-bit steps of 16 (exact: its derivative is 16 * 16 / 255
+// per unit of u everywhere, the clamped edges' one-sided differences too) over the
+// quad's 2 units (UV density 1/2), bump_scale b: the slope b (256 / 255) / 2, which
+// b = 2 tan 30 (255 / 256) makes tan 30 degrees. Along u the normal leans to -x;
+// down the image's rows, where v and the heights grow towards +z, to -z (so that
+// the bitangent's handedness is held too).
+TEST(MaterialRender, ARampBumpMapLightsLikeTheTiltedQuad) {
+  const TiltedQuad quad;
+  std::vector<unsigned char> ramp(16 * 4);
+  for (int i = 0; i < 16; ++i) {
+    for (int c = 0; c < 3; ++c) ramp[4 * i + c] = static_cast<unsigned char>(16 * i);
+    ramp[4 * i + 3] = 255;
+  }
+  const std::string root = quad.folder.root().string();
+  ASSERT_NE(stbi_write_png((root + "/across.png").c_str(), 16, 1, 4, ramp.data(), 16 * 4), 0);
+  ASSERT_NE(stbi_write_png((root + "/down.png").c_str(), 1, 16, 4, ramp.data(), 4), 0);
+  const std::string scale = std::to_string(2.0 * std::tan(kPi / 6.0) * 255.0 / 256.0);
+  for (const auto& [what, file, matrix] :
+       {std::tuple<const char*, const char*, std::string>{"along u", "across.png", TiltedQuad::tilt_to_minus_x()},
+        std::tuple<const char*, const char*, std::string>{"down the rows", "down.png", TiltedQuad::tilt_to_minus_z()}}) {
+    SCOPED_TRACE(what);
+    quad.expect_lights_like_tilted(
+        std::string(R"({"name": "h", "type": "image", "file": ")") + file +
+            R"(", "colorspace": "linear", "wrap": "clamp"})",
+        R"(, "bump_texture": "h", "bump_scale": )" + scale, matrix);
+  }
+}
+
+// Bump maps on a quad and on spheres (a sphere's UV rates), of a lambertian, a
+// plastic and a principled, under a lamp and a sky: a 32 x 32 image of random
+// heights, repeating.
+Scene bump_scene(const test::TestFolder& folder) {
+  std::vector<unsigned char> heights(32 * 32 * 4, 255);
+  uint32_t state = 12345u;
+  for (size_t i = 0; i < 32 * 32; ++i) {
+    state = state * 1664525u + 1013904223u;
+    for (int c = 0; c < 3; ++c) heights[4 * i + c] = static_cast<unsigned char>(state >> 24);
+  }
+  const std::string root = folder.root().string();
+  EXPECT_NE(stbi_write_png((root + "/heights.png").c_str(), 32, 32, 4, heights.data(), 32 * 4), 0);
+  std::ofstream(root + "/quad.obj") << "v -2 0 2\nv 2 0 2\nv 2 0 -2\nv -2 0 -2\n"
+                                       "vt 0 0\nvt 2 0\nvt 2 2\nvt 0 2\nvn 0 1 0\n"
+                                       "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  return parse_scene(R"({"camera": {"look_from": [0, 2.5, 4], "look_at": [0, 0.5, 0], "vfov": 45},
+    "sky": {"type": "uniform", "radiance": [0.3, 0.35, 0.4]},
+    "textures": [{"name": "h", "type": "image", "file": "heights.png", "colorspace": "linear"}],
+    "materials": [{"name": "floor", "type": "lambertian", "albedo": [0.7, 0.7, 0.7], "bump_texture": "h", "bump_scale": 0.01},
+                  {"name": "plastic", "type": "plastic", "albedo": [0.2, 0.4, 0.7], "roughness": 0.2, "bump_texture": "h", "bump_scale": 0.02},
+                  {"name": "gold", "type": "principled", "albedo": [1.0, 0.8, 0.4], "metallic": 1, "roughness": 0.3, "bump_texture": "h", "bump_scale": -0.03},
+                  {"name": "lamp", "type": "emissive", "emission": [30, 30, 30]}],
+    "meshes": [{"name": "quad", "file": "quad.obj"}],
+    "instances": [{"mesh": "quad", "material": "floor"}],
+    "spheres": [{"center": [-0.8, 0.7, 0], "radius": 0.7, "material": "plastic"},
+                {"center": [0.8, 0.7, 0], "radius": 0.7, "material": "gold"},
+                {"center": [2, 4, 2], "radius": 0.5, "material": "lamp"}]})",
+                     (folder.root() / "scene.json").string());
+}
+
+// The CPU's wavefront kernels shade bump maps as its megakernel does.
+TEST(MaterialRender, CpuWavefrontKernelsMatchTheMegakernelOnBumpMaps) {
+  const test::TestFolder folder;
+  const Scene scene = bump_scene(folder);
+  const RenderResult mk = render(scene, options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 4, 8, 3, 1));
+  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
+    const RenderResult wf = render(scene, options_for(Backend::Cpu, k, 32, 18, 4, 8, 3, 1));
+    ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
+    for (size_t i = 0; i < mk.rgb.size(); ++i) {
+      ASSERT_NEAR(wf.rgb[i], mk.rgb[i], 1e-5f * (1.0f + std::fabs(mk.rgb[i]))) << kernel_name(k) << " " << i;
+    }
+  }
+}
+
+TEST(MaterialRender, EveryCudaKernelAgreesWithTheCpuOnBumpMaps) {
+  WT_REQUIRE_CUDA();
+  const test::TestFolder folder;
+  const Scene scene = bump_scene(folder);
+  test::expect_cuda_agrees_with_cpu(
+      [&](Backend b, Kernel k, uint32_t seed) { return render(scene, options_for(b, k, 64, 36, 8, 8, 3, seed)); }, 3);
 }
 
 // --profile's shade by material kind: the same image (to the film's rounding: the

@@ -331,36 +331,53 @@ map_Pm m.png
   EXPECT_TRUE(m.warnings.empty());
 }
 
-// A PBR material's bump map is its tangent-space normal map, -bm its strength; a
-// classic material's is MTL's height map, which is warned of and not read; norm wins
-// over a bump map.
-TEST_F(MeshLoad, MtlBumpMapIsTheNormalMapOfAPbrMaterialWithBmItsStrength) {
+// MTL's bump map, in any material but an emitter: heights times -bm (which may be
+// negative), of the channel -imfchan names (luminance by default), which the scene
+// reads as a normal map where its texels are one's and no channel is named
+// (bump_map_test.cpp); norm wins over a bump map.
+TEST_F(MeshLoad, MtlBumpMapIsReadWithBmItsScale) {
   const TriangleMesh m = load_mtl(R"(newmtl pbr
 Kd 0.5 0.5 0.5
 Pr 0.5
 map_Bump -bm 0.3 tex/normal.png
 newmtl classic
 Kd 0.5 0.5 0.5
-bump -bm 2 tex/height.png
+bump -bm -2 tex/height.png
+newmtl red
+Kd 0.5 0.5 0.5
+map_bump -imfchan r tex/rgb.png
 newmtl both
 Pr 0.5
 norm tex/n.png
 bump tex/h.png
+newmtl lamp
+Ke 1 1 1
+bump tex/h.png
 )");
   const MeshMaterial* pbr = find(m, "pbr");
   const MeshMaterial* classic = find(m, "classic");
+  const MeshMaterial* red = find(m, "red");
   const MeshMaterial* both = find(m, "both");
-  ASSERT_TRUE(pbr && classic && both);
-  EXPECT_EQ(pbr->normal_map.image, at_root("tex/normal.png"));
-  EXPECT_FLOAT_EQ(pbr->normal_scale, 0.3f);
+  const MeshMaterial* lamp = find(m, "lamp");
+  ASSERT_TRUE(pbr && classic && red && both && lamp);
+  EXPECT_TRUE(pbr->normal_map.empty());
+  EXPECT_EQ(pbr->bump_map.image, at_root("tex/normal.png"));
+  EXPECT_FLOAT_EQ(pbr->bump_scale, 0.3f);
+  EXPECT_EQ(pbr->bump_channel, 'l');
+  EXPECT_TRUE(pbr->bump_may_be_normal_map);
   EXPECT_EQ(classic->material.kind, MaterialKind::Lambertian);
-  EXPECT_TRUE(classic->normal_map.empty());
+  EXPECT_EQ(classic->bump_map.image, at_root("tex/height.png"));
+  EXPECT_FLOAT_EQ(classic->bump_scale, -2.0f);
+  EXPECT_EQ(red->bump_channel, 'r');
+  EXPECT_FALSE(red->bump_may_be_normal_map);
   EXPECT_EQ(both->normal_map.image, at_root("tex/n.png"));
   EXPECT_FLOAT_EQ(both->normal_scale, 1.0f);
+  EXPECT_TRUE(both->bump_map.empty());
+  EXPECT_TRUE(lamp->bump_map.empty());
   ASSERT_EQ(m.warnings.size(), 2u);
-  EXPECT_NE(m.warnings[0].find("material 'classic': its bump map 'tex/height.png' is a height map"), std::string::npos)
+  EXPECT_NE(m.warnings[0].find("material 'both': its bump map is not read: norm gives its normal map"), std::string::npos)
       << m.warnings[0];
-  EXPECT_NE(m.warnings[1].find("material 'both': its bump map is not read: norm gives its normal map"), std::string::npos)
+  EXPECT_NE(m.warnings[1].find("material 'lamp': bump is not read: an emitter is not shaded"), std::string::npos)
       << m.warnings[1];
 }
 
@@ -503,7 +520,7 @@ TEST_F(MeshLoad, MtlValuesOutOfRangeAreRefused) {
       {"Pcr 2", "Pcr must be a number in [0, 1]"},
       {"aniso 3", "aniso must be a number in [0, 1]"},
       {"Pr 0.5\nnorm -bm -1 n.png", "norm -bm must be in [0, 1000]"},
-      {"Pr 0.5\nmap_Bump -bm 2000 n.png", "map_Bump -bm must be in [0, 1000]"},
+      {"Pr 0.5\nmap_Bump -bm 2000 n.png", "map_Bump -bm must be in [-1000, 1000]"},
       {"map_Pr -bm 1", "map_Pr names no image"},
       {"Tf 1.5 1 1", "Tf must be 3 numbers in [0, 1]"},
       {"d -halo 0.5", "d must be a number in [0, 1]"},

@@ -278,7 +278,7 @@ TEST(SceneParser, UnknownKeysAreRejectedAtEveryLevel) {
   expect_error(with(doc, "/textures/0/colour", {1, 1, 1}), "/textures/0/colour",
                "unknown key for type 'checker'");
   expect_error(with(doc, "/materials/2/fuzz", 0), "/materials/2/fuzz",
-               "unknown key for type 'dielectric' (expected name, type, ior, albedo, normal_texture, normal_strength)");
+               "unknown key for type 'dielectric' (expected name, type, ior, albedo, normal_texture, normal_strength, bump_texture, bump_scale)");
   expect_error(with(doc, "/spheres/1/mat", "glass"), "/spheres/1/mat", "unknown key");
   expect_error(with(doc, "/spheres/1/a~0b", 1), "/spheres/1/a~0b", "unknown key");
 }

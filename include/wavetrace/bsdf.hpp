@@ -30,6 +30,32 @@ struct BsdfInputs {
   const ImageView* images;
 };
 
+// The shading normal a bump (height) map gives about normal n: the surface displaced
+// along n by d = scale h, its normal n - grad d, d's gradient along the surface to
+// first order (Blinn 1978). The map's texel holds h's derivatives in the texture's
+// coordinates (dh/du', dh/dv'); the UV transform's Jacobian J (texture_uv) carries
+// them to the surface's u and v (J^T), and the UV rates, UV units per unit length
+// along u and v, to world units: a triangle's uv_density on both (exact where its UV
+// map neither shears nor stretches one axis against the other), a sphere's
+// 1 / (2 pi r sin theta) along u and 1 / (pi r) along v. Without UVs (density 0) the
+// surface is not bumped.
+WT_HD WT_INLINE vec3 bumped_normal(const vec3& n, const SurfacePoint& sp, const Texture& t, const vec3& texel,
+                                   float scale) {
+  const vec2 g(t.uv_cos * texel.x - t.uv_sin * texel.y, t.uv_sin * texel.x + t.uv_cos * texel.y);
+  vec2 rate(sp.uv_density);
+  if (!sp.has_uv) {
+    const float r = sqrtf(glm::dot(sp.local, sp.local));
+    const float sin_theta = fmaxf(sqrtf(fmaxf(1.0f - sp.n.y * sp.n.y, 0.0f)), 1e-4f);
+    rate = r > 0.0f ? vec2(0.5f / (kPi * r * sin_theta), 1.0f / (kPi * r)) : vec2(0.0f);
+  }
+  const vec2 slope = scale * g * t.uv_scale * rate;  // d's derivatives along u and v, per unit length
+  // B times tangent_sign points towards decreasing v.
+  const Frame f = Frame::about(n, sp.dpdu);
+  const vec3 m = n - slope.x * f.t + (slope.y * sp.tangent_sign) * f.b;
+  const float len2 = glm::dot(m, m);
+  return len2 > 1e-12f && len2 < 1e30f ? m * (1.0f / sqrtf(len2)) : n;
+}
+
 // Principled's textured coat (weight: red; roughness: green; its normal map) and
 // transmission (red), looked up where the material has them. Layers = false: a
 // kernel without principled's layers (kLayersAndAlpha), for scenes whose
@@ -113,6 +139,10 @@ WT_HD WT_INLINE BsdfAt bsdf_at(const Material& m, const BsdfInputs& in, const Su
       if (b.p.normal_texture >= 0) {
         b.n = mapped_normal(sp.n, sp.dpdu, sp.tangent_sign,
                             eval_texture(in.textures[b.p.normal_texture], in.images, sp), b.p.normal_strength);
+      }
+      if (b.p.bump_texture >= 0) {
+        const Texture& t = in.textures[b.p.bump_texture];
+        b.n = bumped_normal(b.n, sp, t, eval_texture(t, in.images, sp), b.p.bump_scale);
       }
       b.n = facing_viewer(b.n, wo, b.front);
       if (b.kind == MaterialKind::Principled) principled_textures<Layers>(b, in, sp, wo);

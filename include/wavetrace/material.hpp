@@ -45,6 +45,12 @@ struct MaterialParams {
   int32_t roughness_texture = -1;  // -1, or the texture whose green channel scales the roughness
   int32_t normal_texture = -1;     // -1, or a tangent-space normal map (linear colour)
   float normal_strength = 1.0f;    // scales the normal map's x and y (glTF's normalTexture.scale)
+  // A bump (height) map: -1, or a texture of the height's derivatives (dh/du, dh/dv,
+  // per unit of its coordinates: the scene's height_gradient of the height image),
+  // the surface displaced along its normal by bump_scale times the height, in the
+  // scene's units (bumped_normal).
+  int32_t bump_texture = -1;
+  float bump_scale = 1.0f;
   // Plastic: the share of a metal of f0 = albedo at the coat's roughness (glTF's
   // metallic), scaled by metallic_texture's blue channel where it has one; and the
   // metal's energy tables (the conductors', -1: uncompensated).

@@ -337,38 +337,38 @@ MeshMaterial map_mtl(const tinyobj::material_t& t, const MtlKeys& k, const fs::p
     warn("map_Ke is not read: its Ke is black (no emission to texture)");
   }
 
-  // Normal maps. wavetrace renders tangent-space normal maps, not height maps. norm is
-  // one; MTL's bump (map_Bump) is a height map, except in a material that writes the
-  // PBR keys, whose writers put the tangent-space normal map there (with -bm its
-  // strength) when they do not write norm.
-  const std::string* normal = nullptr;
-  const tinyobj::texture_option_t* normal_options = nullptr;
-  const char* normal_key = "norm";
+  // Normal and bump maps. norm is a tangent-space normal map (of a PBR material:
+  // norm is a PBR key). MTL's bump (map_Bump) is a height map, times -bm in the
+  // scene's units; exporters also write tangent-space normal maps there (with -bm
+  // their strength), which the scene tells by the image's texels where no -imfchan
+  // names a channel of heights. norm wins over a bump map.
+  const bool emits = out.material.kind == MaterialKind::Emissive;
+  const char* bump_key = k.has("map_Bump") ? "map_Bump" : k.has("map_bump") ? "map_bump" : "bump";
   if (!t.normal_texname.empty()) {
-    normal = &t.normal_texname;
-    normal_options = &t.normal_texopt;
-  }
-  if (!t.bump_texname.empty()) {
-    if (normal) {
-      warn("its bump map is not read: norm gives its normal map");
-    } else if (pbr) {
-      normal = &t.bump_texname;
-      normal_options = &t.bump_texopt;
-      normal_key = k.has("map_Bump") ? "map_Bump" : k.has("map_bump") ? "map_bump" : "bump";
+    if (emits) {
+      warn("norm is not read: an emitter is not shaded");
     } else {
-      warn("its bump map '" + t.bump_texname +
-           "' is a height map (the material writes no PBR key), which wavetrace does not render; a tangent-space "
-           "normal map is read from norm");
+      out.normal_map = texture(t.normal_texname);
+      const float bm = t.normal_texopt.bump_multiplier;
+      if (!(bm >= 0.0f && bm <= 1e3f)) fail(path, what + ": norm -bm must be in [0, 1000]");
+      out.normal_scale = bm;
     }
   }
-  if (normal) {
-    if (out.material.kind != MaterialKind::Principled) {
-      warn(std::string(normal_key) + " is not read: an emitter is not shaded");
+  if (!t.bump_texname.empty()) {
+    if (!t.normal_texname.empty()) {
+      warn("its bump map is not read: norm gives its normal map");
+    } else if (emits) {
+      warn(std::string(bump_key) + " is not read: an emitter is not shaded");
     } else {
-      out.normal_map = texture(*normal);
-      const float bm = normal_options->bump_multiplier;
-      if (!(bm >= 0.0f && bm <= 1e3f)) fail(path, what + ": " + normal_key + " -bm must be in [0, 1000]");
-      out.normal_scale = bm;
+      out.bump_map = texture(t.bump_texname);
+      const float bm = t.bump_texopt.bump_multiplier;
+      if (!(bm >= -1e3f && bm <= 1e3f)) fail(path, what + ": " + bump_key + " -bm must be in [-1000, 1000]");
+      out.bump_scale = bm;
+      // tinyobjloader's default channel for a bump map is l (luminance).
+      const char c = t.bump_texopt.imfchan;
+      if (c == 'z') warn(std::string(bump_key) + " -imfchan z is not honoured: its heights are the image's luminance");
+      out.bump_channel = c == 'r' || c == 'g' || c == 'b' || c == 'm' ? c : 'l';
+      out.bump_may_be_normal_map = out.bump_channel == 'l';
     }
   }
 

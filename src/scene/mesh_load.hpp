@@ -57,6 +57,16 @@ struct MeshMaterial {
   // metallicRoughnessTexture is both (one texture), MTL's map_Pr and map_Pm each one.
   MeshTexture roughness_map, metallic_map, normal_map;
   float normal_scale = 1.0f;
+  // MTL's bump map (map_Bump, bump), any kind but an emitter: a height map, its
+  // bump_channel ('l' luminance, 'r', 'g', 'b', or 'm': alpha) times bump_scale (-bm)
+  // displacing the surface along its normal in the scene's units; but where no
+  // -imfchan is written and its image reads as a tangent-space normal map (the
+  // scene decides, by the image's texels: height_maps.hpp), that normal map, of
+  // strength bump_scale. Empty where norm gives the normal map.
+  MeshTexture bump_map;
+  float bump_scale = 1.0f;
+  char bump_channel = 'l';
+  bool bump_may_be_normal_map = true;
   // KHR_materials_clearcoat (MTL's Pc, Pcr): the coat's weight and roughness, times
   // clearcoat_map's R and clearcoat_roughness_map's G; the coat's own normal map
   // (none: the coat follows the surface, not the base's normal map).

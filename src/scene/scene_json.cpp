@@ -45,12 +45,25 @@ void SceneReader::read(const json& root) {
     fail_at(top / "spheres", "the scene has nothing to render: it needs at least one sphere or one instance");
   }
   place_mesh_camera();
+  // An image that nothing reads (a bump map's heights, whose derivatives are what
+  // its texture reads) keeps one black texel, not its texels on the device.
+  std::vector<bool> read(scene_.images.size(), false);
+  for (const Texture& t : scene_.textures) {
+    if (t.kind == TextureKind::Image) read[static_cast<size_t>(t.image)] = true;
+  }
+  if (scene_.sky.image >= 0) read[static_cast<size_t>(scene_.sky.image)] = true;
+  for (size_t i = 0; i < read.size(); ++i) {
+    if (read[i]) continue;
+    Image& im = scene_.images[i];
+    im.width = im.height = 1;
+    im.texels.assign(4, 0.0f);
+  }
   const auto start = Clock::now();
   build_texture_mips(scene_);
   texture_seconds_ += seconds_since(start);
-  // Tangents per vertex only where a normal map needs them.
+  // Tangents per vertex only where a normal or bump map needs them.
   for (const MaterialParams& p : scene_.material_params) {
-    if (p.normal_texture >= 0) {
+    if (p.normal_texture >= 0 || p.bump_texture >= 0) {
       build_tangents(scene_, file_tangents_);
       break;
     }

@@ -1,4 +1,5 @@
 // Scene files: materials.
+#include <cmath>
 #include <sstream>
 
 #include "scene/bsdf_tables.hpp"
@@ -25,19 +26,19 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   static const std::vector<std::string> kTypes = {"lambertian", "metal", "dielectric", "coated",
                                                   "emissive",   "conductor", "glass", "plastic", "principled"};
   static const std::vector<std::vector<std::string>> kKeys = {
-      {"name", "type", "albedo", "texture", "normal_texture", "normal_strength"},
-      {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength"},
-      {"name", "type", "ior", "albedo", "normal_texture", "normal_strength"},
-      {"name", "type", "albedo", "ior", "texture", "normal_texture", "normal_strength"},
+      {"name", "type", "albedo", "texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
+      {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
+      {"name", "type", "ior", "albedo", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
+      {"name", "type", "albedo", "ior", "texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
       {"name", "type", "emission", "emission_texture"},
       {"name", "type", "roughness", "anisotropy", "metal", "eta", "k", "f0", "energy_compensation", "masking",
-       "roughness_texture", "normal_texture", "normal_strength"},
+       "roughness_texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
       {"name", "type", "ior", "roughness", "tint", "thin", "energy_compensation", "masking", "roughness_texture",
-       "normal_texture", "normal_strength"},
+       "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
       {"name", "type", "albedo", "texture", "ior", "roughness", "masking", "roughness_texture", "normal_texture",
-       "normal_strength", "metallic", "metallic_texture", "energy_compensation"},
+       "normal_strength", "bump_texture", "bump_scale", "metallic", "metallic_texture", "energy_compensation"},
       {"name", "type", "albedo", "texture", "ior", "roughness", "anisotropy", "metallic", "roughness_texture",
-       "metallic_texture", "normal_texture", "normal_strength", "energy_compensation", "masking", "double_sided",
+       "metallic_texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale", "energy_compensation", "masking", "double_sided",
        "specular", "clearcoat", "clearcoat_roughness", "clearcoat_texture", "clearcoat_roughness_texture",
        "clearcoat_normal_texture", "clearcoat_normal_strength", "transmission", "transmission_texture", "thin",
        "attenuation_color", "attenuation_distance", "emission", "emission_texture", "specular_texture",
@@ -80,7 +81,8 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
     if (m.emission.x > 0.0f || m.emission.y > 0.0f || m.emission.z > 0.0f) m.flags |= kMaterialEmits;
   }
   if (m.kind == MaterialKind::Conductor || m.kind == MaterialKind::Glass || m.kind == MaterialKind::Plastic ||
-      m.kind == MaterialKind::Principled || j.contains("normal_texture")) {
+      m.kind == MaterialKind::Principled || j.contains("normal_texture") || j.contains("bump_texture") ||
+      j.contains("bump_scale")) {
     read_params(j, path, m);
   }
   m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, texture_kind));
@@ -111,6 +113,22 @@ void SceneReader::read_params(const json& j, const JsonPath& path, Material& m) 
     }
   }
   if (j.contains("normal_strength")) p.normal_strength = non_negative(j["normal_strength"], path / "normal_strength");
+  // A bump map: an image's heights (its luminance), times bump_scale in the scene's units.
+  if (j.contains("bump_texture")) {
+    const JsonPath at = path / "bump_texture";
+    if (p.normal_texture >= 0) fail_at(at, "a material takes a normal map or a bump map, not both");
+    const Texture& heights = scene_.textures[static_cast<size_t>(texture_named(j["bump_texture"], at))];
+    if (heights.kind != TextureKind::Image) fail_at(at, "a bump map is an image of heights: name an image texture");
+    if (scene_.images[static_cast<size_t>(heights.image)].srgb_decoded) {
+      fail_at(at, "a bump map holds heights, not colours: give its image texture \"colorspace\": \"linear\"");
+    }
+    p.bump_texture = bump_texture(heights, HeightChannel::Luminance);
+  }
+  if (j.contains("bump_scale")) {
+    if (!j.contains("bump_texture")) fail_at(path / "bump_scale", "scales a bump map: give \"bump_texture\" too");
+    p.bump_scale = number(j["bump_scale"], path / "bump_scale");
+    if (!(std::fabs(p.bump_scale) <= 1e3f)) fail_at(path / "bump_scale", "must be in [-1000, 1000]");
+  }
   // Textured roughness scales the roughness, which then defaults to 1.
   const float roughness = j.contains("roughness")           ? unit_interval(j["roughness"], path / "roughness")
                           : p.roughness_texture >= 0 ? 1.0f

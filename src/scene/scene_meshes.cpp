@@ -84,7 +84,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
       Material m = mm.material;
       // As the file samples it (OBJ's maps, and glTF's default sampler, repeat on
       // both axes), its image a file or one the mesh file holds.
-      auto texture_of = [&](const MeshTexture& mt, bool srgb) {
+      auto texture_for = [&](const MeshTexture& mt, bool srgb) {
         const std::string* embedded = nullptr;
         for (const EmbeddedImage& e : mesh.embedded) embedded = e.key == mt.image ? &e.bytes : embedded;
         Texture t = image_texture(image_file(mt.image, srgb, mesh.source, embedded), mt.wrap_u, mt.wrap_v);
@@ -94,7 +94,10 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
         t.uv_scale = mt.uv_scale;
         t.uv_cos = std::cos(mt.uv_rotation);
         t.uv_sin = std::sin(mt.uv_rotation);
-        scene_.textures.push_back(t);
+        return t;
+      };
+      auto texture_of = [&](const MeshTexture& mt, bool srgb) {
+        scene_.textures.push_back(texture_for(mt, srgb));
         return static_cast<int32_t>(scene_.textures.size() - 1);
       };
       // A linear map read as another already is (glTF's metallic with its roughness,
@@ -102,6 +105,24 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
       // looks up once; the same image under another transform or sampler is its own.
       auto shared_or_new = [&](const MeshTexture& mt, const MeshTexture& other, int32_t other_texture) {
         return other_texture >= 0 && mt.same_lookup(other) ? other_texture : texture_of(mt, false);
+      };
+      // MTL's bump map: heights, or a normal map where its texels read as one.
+      auto add_bump = [&](MaterialParams& p) {
+        if (mm.bump_map.empty()) return;
+        const Texture heights = texture_for(mm.bump_map, false);
+        if (mm.bump_may_be_normal_map && reads_as_normal_map(scene_.images[static_cast<size_t>(heights.image)])) {
+          scene_.textures.push_back(heights);
+          p.normal_texture = static_cast<int32_t>(scene_.textures.size() - 1);
+          p.normal_strength = mm.bump_scale;
+          return;
+        }
+        const char c = mm.bump_channel;
+        p.bump_texture = bump_texture(heights, c == 'r'   ? HeightChannel::Red
+                                               : c == 'g' ? HeightChannel::Green
+                                               : c == 'b' ? HeightChannel::Blue
+                                               : c == 'm' ? HeightChannel::Alpha
+                                                          : HeightChannel::Luminance);
+        p.bump_scale = mm.bump_scale;
       };
       if (!mm.albedo_map.empty()) {
         m.texture = texture_of(mm.albedo_map, true);
@@ -135,7 +156,15 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
           p.metallic_texture = shared_or_new(mm.metallic_map, mm.roughness_map, p.roughness_texture);
         }
         if (!mm.normal_map.empty()) p.normal_texture = texture_of(mm.normal_map, false);
+        add_bump(p);
         prepare_microfacet(m, p, scene_.bsdf_tables, shared_tables_);
+        m.params = static_cast<int32_t>(scene_.material_params.size());
+        scene_.material_params.push_back(p);
+      } else if (!mm.bump_map.empty()) {
+        // Another kind with a bump map: parameters of its own, which only the
+        // kernels with them (kMicrofacet) read.
+        MaterialParams p{};
+        add_bump(p);
         m.params = static_cast<int32_t>(scene_.material_params.size());
         scene_.material_params.push_back(p);
       }

@@ -9,10 +9,12 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "scene/bsdf_tables.hpp"
+#include "scene/height_maps.hpp"
 #include "scene/json_reader.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
@@ -70,6 +72,10 @@ class SceneReader : JsonReader {
                      const std::string* embedded = nullptr);
   // The image's index, or -1 with the reason in `why`.
   int32_t image_at(const std::string& resolved, bool srgb, std::string& why, const std::string* embedded = nullptr);
+  // A bump map's texture: `heights` (an image texture, linear) with its image
+  // replaced by the image of its heights' derivatives (height_gradient; one per
+  // image, channel and wrap), its transform and filters kept.
+  int32_t bump_texture(const Texture& heights, HeightChannel channel);
 
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);
@@ -107,6 +113,8 @@ class SceneReader : JsonReader {
     bool chosen = false;
   } mesh_camera_;
   std::map<std::pair<std::string, bool>, int32_t> images_;
+  // height_gradient's images by (height image, channel, wrap u, wrap v).
+  std::map<std::tuple<int32_t, HeightChannel, Wrap, Wrap>, int32_t> gradients_;
   double texture_seconds_ = 0;
   double mesh_seconds_ = 0;
   // The mesh files' own tangents, per vertex of the scene's normal and UV arrays

@@ -89,6 +89,27 @@ int32_t SceneReader::image(const std::string& file, bool srgb, const JsonPath& p
   return index;
 }
 
+int32_t SceneReader::bump_texture(const Texture& heights, HeightChannel channel) {
+  const auto key = std::make_tuple(heights.image, channel, heights.wrap_u, heights.wrap_v);
+  auto known = gradients_.find(key);
+  int32_t image;
+  if (known != gradients_.end()) {
+    image = known->second;
+  } else {
+    const auto start = Clock::now();
+    Image gradient = height_gradient(scene_.images[static_cast<size_t>(heights.image)], channel, heights.wrap_u,
+                                     heights.wrap_v);
+    texture_seconds_ += seconds_since(start);
+    image = static_cast<int32_t>(scene_.images.size());
+    scene_.images.push_back(std::move(gradient));
+    gradients_.emplace(key, image);
+  }
+  Texture t = heights;
+  t.image = image;
+  scene_.textures.push_back(t);
+  return static_cast<int32_t>(scene_.textures.size() - 1);
+}
+
 int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const std::string& referrer,
                                 const std::string* embedded) {
   std::string why;

@@ -1,0 +1,69 @@
+#include "scene/height_maps.hpp"
+
+#include <cmath>
+
+namespace wt {
+
+namespace {
+
+float height_of(const float* texel, HeightChannel channel) {
+  switch (channel) {
+    case HeightChannel::Luminance: return 0.2126f * texel[0] + 0.7152f * texel[1] + 0.0722f * texel[2];
+    case HeightChannel::Red: return texel[0];
+    case HeightChannel::Green: return texel[1];
+    case HeightChannel::Blue: return texel[2];
+    case HeightChannel::Alpha: return texel[3];
+  }
+  return 0.0f;
+}
+
+// h's derivative at index i of n along one axis, per unit of the coordinate (n
+// texels), from the texels either side (get(j)).
+template <class Get>
+float derivative(int i, int n, Wrap wrap, const Get& get) {
+  if (n < 2) return 0.0f;
+  const bool joined = wrap == Wrap::Repeat;  // the last texel's neighbour is the first
+  const int before = i > 0 || joined ? 1 : 0, after = i < n - 1 || joined ? 1 : 0;
+  const int lo = before ? (i - 1 + n) % n : i, hi = after ? (i + 1) % n : i;
+  return (get(hi) - get(lo)) * static_cast<float>(n) / static_cast<float>(before + after);
+}
+
+}  // namespace
+
+Image height_gradient(const Image& height, HeightChannel channel, Wrap wrap_u, Wrap wrap_v) {
+  Image out;
+  out.path = height.path;
+  out.width = height.width;
+  out.height = height.height;
+  const int w = height.width, h = height.height;
+  std::vector<float> heights(static_cast<size_t>(w) * h);
+  for (size_t i = 0; i < heights.size(); ++i) heights[i] = height_of(&height.texels[4 * i], channel);
+  out.texels.assign(heights.size() * 4, 0.0f);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t row = static_cast<size_t>(y) * w;
+      float* t = &out.texels[4 * (row + x)];
+      t[0] = derivative(x, w, wrap_u, [&](int j) { return heights[row + j]; });
+      t[1] = derivative(y, h, wrap_v, [&](int j) { return heights[static_cast<size_t>(j) * w + x]; });
+      t[3] = 1.0f;
+    }
+  }
+  return out;
+}
+
+bool reads_as_normal_map(const Image& image) {
+  const size_t n = static_cast<size_t>(image.width) * image.height;
+  if (n == 0) return false;
+  bool grey = true;
+  size_t vectors = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const float* c = &image.texels[4 * i];
+    grey = grey && std::fabs(c[0] - c[1]) <= 2.0f / 255.0f && std::fabs(c[1] - c[2]) <= 2.0f / 255.0f;
+    const float x = 2.0f * c[0] - 1.0f, y = 2.0f * c[1] - 1.0f, z = 2.0f * c[2] - 1.0f;
+    const float length = std::sqrt(x * x + y * y + z * z);
+    if (length >= 0.7f && length <= 1.3f && z >= -0.02f) ++vectors;
+  }
+  return !grey && static_cast<double>(vectors) >= 0.99 * static_cast<double>(n);
+}
+
+}  // namespace wt
