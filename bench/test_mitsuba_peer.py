@@ -995,10 +995,17 @@ class TexturedMaterialTest(Base):
         with self.assertRaisesRegex(mp.ConversionError, "colorspace"):
             self.bsdfs([{"name": "s", "type": "lambertian", "normal_texture": "map_srgb"}])
 
-    def test_a_bump_map_is_named_as_not_converted(self):
-        conv, b = self.bsdfs([{"name": "l", "type": "lambertian", "bump_texture": "map", "bump_scale": 0.1}])
-        self.assertEqual(b[0]["type"], "diffuse")                       # as it is, unbumped
-        self.assertIn("bump_texture 'map' of 'l': not converted", " ".join(conv.notes))
+    def test_a_bump_map_wraps_the_bsdf(self):
+        conv, b = self.bsdfs([{"name": "l", "type": "lambertian", "bump_texture": "map", "bump_scale": 0.1},
+                              {"name": "p", "type": "plastic", "roughness": 0.3, "bump_texture": "map"},
+                              {"name": "flat", "type": "lambertian", "bump_texture": "map", "bump_scale": 0}])
+        l, p, flat = b
+        self.assertEqual((l["type"], l["scale"], l["bsdf"]["type"]), ("bumpmap", 0.1, "diffuse"))
+        self.assertEqual((l["arbitrary"]["type"], l["arbitrary"]["raw"]), ("bitmap", True))
+        self.assertEqual((p["type"], p["scale"], p["bsdf"]["type"]), ("bumpmap", 1.0, "twosided"))
+        self.assertEqual(flat["type"], "diffuse")                         # scale 0: no perturbation
+        self.assertIn("bump maps: both displace", " ".join(conv.notes))
+        self.assertIn("bumpmap", conv.plugins())
 
     def test_normal_map_on_a_mesh(self):
         conv = mp.convert(os.path.join(ROOT, "scenes", "materials-single.json"))

@@ -33,9 +33,9 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
 # "scene" is part of libmitsuba. The glTF tiles add principledthin, mask, the
 # punctual lights (point, spot, directional), and volpath with a homogeneous
-# medium of a constvolume for absorbing volumes.
+# medium of a constvolume for absorbing volumes; bump maps add bumpmap.
 PLUGINS="area isotropic bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
-normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
+bumpmap normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
 srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume"
 
 py_local=$(command -v python3)

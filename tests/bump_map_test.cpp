@@ -287,5 +287,38 @@ TEST_F(BumpScene, SceneFileBumpTextureAndItsErrors) {
   }
 }
 
+// The shipped comparison scene: the heights' image is the normal map's bumps. At
+// each texel the heights' central differences (per texel, times H = 15.6 texels)
+// give the normal the normal map stores, to the 8-bit rounding of both images
+// (within 0.06 in each of x and y) away from the bumps' rims.
+TEST(BumpMapScene, TheShippedHeightsAreTheNormalMapsBumps) {
+  const Scene s = load_scene(test::repo_path("scenes/bump-single.json"));
+  int32_t bump = -1, normal = -1;
+  for (const Material& m : s.materials) {
+    if (m.params < 0) continue;
+    const MaterialParams& p = s.material_params[static_cast<size_t>(m.params)];
+    if (p.bump_texture >= 0) bump = bump < 0 ? p.bump_texture : bump;
+    if (p.normal_texture >= 0) normal = p.normal_texture;
+  }
+  ASSERT_GE(bump, 0);
+  ASSERT_GE(normal, 0);
+  const Image& g = s.images[static_cast<size_t>(s.textures[static_cast<size_t>(bump)].image)];
+  const Image& n = s.images[static_cast<size_t>(s.textures[static_cast<size_t>(normal)].image)];
+  ASSERT_EQ(g.width, n.width);
+  ASSERT_EQ(g.height, n.height);
+  const float h = 0.6f * 26.0f / static_cast<float>(g.width);  // H per unit of u, over the texels per unit
+  int compared = 0;
+  for (size_t i = 0; i < static_cast<size_t>(g.width) * g.height; ++i) {
+    const vec3 want = glm::normalize(vec3(-h * g.texels[4 * i], h * g.texels[4 * i + 1], 1.0f));
+    const vec3 got = 2.0f * vec3(n.texels[4 * i], n.texels[4 * i + 1], n.texels[4 * i + 2]) - 1.0f;
+    if (got.z < 0.9f && got.z > 0.75f) {  // on the flanks: both images well resolved
+      EXPECT_NEAR(got.x, want.x, 0.06f) << i;
+      EXPECT_NEAR(got.y, want.y, 0.06f) << i;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 5000);
+}
+
 }  // namespace
 }  // namespace wt

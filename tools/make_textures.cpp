@@ -385,44 +385,68 @@ bool write_hdr(const std::filesystem::path& path, int width, int height, const s
   return true;
 }
 
-// bumps_normal.png: a tileable tangent-space normal map of round bumps, 256 x 256,
-// the normal n stored as n / 2 + 1/2 (flat is (128, 128, 255)), in the OpenGL and
-// glTF convention wavetrace's normal_texture reads (docs/scene-format.md): +x
-// (red) along +u, +y (green) up the image, +z (blue) out of the surface; read it
-// with "colorspace": "linear". Sixteen bumps in four rows of four, one every 64
-// texels, every other row shifted by half a bump, so that the image tiles both
-// ways. A bump of radius R = 26 texels has the height h(r) = H (1 - (r/R)^2)^2,
-// H = 0.6 R: level at its top and at its rim, steepest (43 degrees) at R / sqrt(3).
-// The normal (-dh/dx, dh/drow, 1), normalized, is evaluated analytically at each
-// texel's centre, so nothing is sampled and nothing aliases.
-Image8 make_bumps_normal() {
-  constexpr int kSize = 256, kPitch = 64;
-  constexpr double kRadius = 26.0, kHeight = 0.6 * kRadius;
-  Image8 img(kSize, kSize);
-  for (int row = 0; row < kSize; ++row) {
-    for (int col = 0; col < kSize; ++col) {
-      const double x = col + 0.5, y = row + 0.5;
-      double gx = 0.0, gy = 0.0;
-      for (int j = 0; j < kSize / kPitch; ++j) {
-        for (int i = 0; i < kSize / kPitch; ++i) {
-          const double cx = std::fmod((i + 0.5 + 0.5 * (j % 2)) * kPitch, kSize), cy = (j + 0.5) * kPitch;
-          // The nearest copy of the bump on the torus.
-          const double dx = std::fmod(x - cx + 1.5 * kSize, kSize) - 0.5 * kSize;
-          const double dy = std::fmod(y - cy + 1.5 * kSize, kSize) - 0.5 * kSize;
-          const double s = (dx * dx + dy * dy) / (kRadius * kRadius);
-          if (s < 1.0) {
-            const double k = -4.0 * kHeight * (1.0 - s) / (kRadius * kRadius);  // dh/dx = k dx
-            gx += k * dx;
-            gy += k * dy;
-          }
-        }
+// The round bumps of bumps_normal.png and bumps_height.png, 256 x 256 texels:
+// sixteen bumps in four rows of four, one every 64 texels, every other row shifted
+// by half a bump, so that the images tile both ways. A bump of radius R = 26 texels
+// has the height h(r) = H (1 - (r/R)^2)^2, H = 0.6 R: level at its top and at its
+// rim, steepest (43 degrees) at R / sqrt(3). The bumps do not overlap. At (x, y) in
+// texels (y down the rows): the height and its derivatives, analytically.
+constexpr int kBumpsSize = 256, kBumpsPitch = 64;
+constexpr double kBumpRadius = 26.0, kBumpHeight = 0.6 * kBumpRadius;
+
+void bumps_at(double x, double y, double& h, double& gx, double& gy) {
+  h = gx = gy = 0.0;
+  for (int j = 0; j < kBumpsSize / kBumpsPitch; ++j) {
+    for (int i = 0; i < kBumpsSize / kBumpsPitch; ++i) {
+      const double cx = std::fmod((i + 0.5 + 0.5 * (j % 2)) * kBumpsPitch, kBumpsSize), cy = (j + 0.5) * kBumpsPitch;
+      // The nearest copy of the bump on the torus.
+      const double dx = std::fmod(x - cx + 1.5 * kBumpsSize, kBumpsSize) - 0.5 * kBumpsSize;
+      const double dy = std::fmod(y - cy + 1.5 * kBumpsSize, kBumpsSize) - 0.5 * kBumpsSize;
+      const double s = (dx * dx + dy * dy) / (kBumpRadius * kBumpRadius);
+      if (s < 1.0) {
+        h += kBumpHeight * (1.0 - s) * (1.0 - s);
+        const double k = -4.0 * kBumpHeight * (1.0 - s) / (kBumpRadius * kBumpRadius);  // dh/dx = k dx
+        gx += k * dx;
+        gy += k * dy;
       }
-      // Up the image is -row: n.y = dh/drow.
-      const vec3 n = glm::normalize(vec3(static_cast<float>(-gx), static_cast<float>(gy), 1.0f));
-      img.set(col, row, 0.5f * n + vec3(0.5f));
+    }
+  }
+}
+
+// An image of the bumps, colour(h, dh/dx, dh/drow) at each texel's centre.
+template <class Colour>
+Image8 bumps_image(const Colour& colour) {
+  Image8 img(kBumpsSize, kBumpsSize);
+  for (int row = 0; row < kBumpsSize; ++row) {
+    for (int col = 0; col < kBumpsSize; ++col) {
+      double h, gx, gy;
+      bumps_at(col + 0.5, row + 0.5, h, gx, gy);
+      img.set(col, row, colour(h, gx, gy));
     }
   }
   return img;
+}
+
+// bumps_normal.png: the bumps as a tangent-space normal map, the normal n stored as
+// n / 2 + 1/2 (flat is (128, 128, 255)), in the OpenGL and glTF convention
+// wavetrace's normal_texture reads (docs/scene-format.md): +x (red) along +u, +y
+// (green) up the image, +z (blue) out of the surface; read it with "colorspace":
+// "linear". The normal (-dh/dx, dh/drow, 1), normalized, is evaluated analytically
+// at each texel's centre, so nothing is sampled and nothing aliases.
+Image8 make_bumps_normal() {
+  return bumps_image([](double, double gx, double gy) {
+    // Up the image is -row: n.y = dh/drow.
+    const vec3 n = glm::normalize(vec3(static_cast<float>(-gx), static_cast<float>(gy), 1.0f));
+    return 0.5f * n + vec3(0.5f);
+  });
+}
+
+// bumps_height.png: the same bumps as heights, h / H at each texel's centre (grey,
+// 8-bit, linear: read it with "colorspace": "linear"). As a bump map of a surface
+// where a texel is w units wide, bump_scale H w (H = 15.6 texels) makes the bumps of
+// the normal map.
+Image8 make_bumps_height() {
+  return bumps_image([](double h, double, double) { return vec3(static_cast<float>(h / kBumpHeight)); });
 }
 
 bool write_png(const std::filesystem::path& path, const Image8& img) {
@@ -464,6 +488,7 @@ int main(int argc, char** argv) {
   for (const auto& p : probes) ok = write_png(out / p.file, make_probe(p.env, kProbe)) && ok;
   ok = write_png(out / "planet.png", make_planet(756, 378)) && ok;
   ok = write_png(out / "bumps_normal.png", make_bumps_normal()) && ok;
+  ok = write_png(out / "bumps_height.png", make_bumps_height()) && ok;
   ok = write_hdr(out / "sky_sun.hdr", 512, 256, make_sky(512, 256)) && ok;
   return ok ? 0 : 1;
 }
