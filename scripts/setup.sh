@@ -23,3 +23,10 @@ if ((${#missing[@]})); then
   $sudo_cmd apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
+# Intel Open Image Denoise, which only --denoise needs (src/image/denoise.hpp): the
+# libraries of the PyPI wheel pyoidn, unpacked into .deps/oidn/lib. Without network
+# the rest of the set-up stands, and --denoise says OIDN is missing.
+if [[ "${WAVETRACE_WITH_OIDN:-1}" == 1 ]]; then
+  python3 "$(dirname "${BASH_SOURCE[0]}")/fetch-oidn.py" ||
+    echo "setup: Open Image Denoise not installed: --denoise will not run (the tests that need it skip)" >&2
+fi
