@@ -25,6 +25,11 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
                         "no light sampling: pure path tracing (the same as --nee 0)");
   cmd.add_flag("--exr-float", job.exr_float, "OpenEXR output in 32-bit floats (default: half floats)");
   cmd.add_flag("--profile", job.profile, "print the load phases and the wavefront's per-stage times");
+  cmd.add_flag("--denoise", job.denoise,
+               "write the image Intel Open Image Denoise makes of the render (scripts/setup.sh installs it)");
+  cmd.add_option("--denoise-quality", job.denoise_quality, "the denoiser's quality: high (default) or balanced")
+      ->check(CLI::IsMember(denoise_quality_choices()));
+  cmd.add_flag("--keep-noisy", job.keep_noisy, "with --denoise: write the render itself too, as NAME.noisy.EXT");
 }
 
 void set_encoding(Job& job, const std::string& encoding) {
@@ -71,6 +76,11 @@ std::vector<std::string> render_arguments(const Job& job) {
   if (job.devices != "all") add("--devices", job.devices);
   add("--encoding", encoding_choices()[job.encoding == Encoding::Srgb ? 0 : 1]);
   if (job.exr_float) args.push_back("--exr-float");
+  if (job.denoise) {
+    args.push_back("--denoise");
+    add("--denoise-quality", job.denoise_quality);
+  }
+  if (job.keep_noisy) args.push_back("--keep-noisy");
   if (!job.progress) args.push_back("--quiet");
   if (job.profile) args.push_back("--profile");
   args.push_back("--");  // the scene, whatever its name

@@ -20,6 +20,7 @@
 #include "app/stats.hpp"
 #include "device/device.hpp"
 #include "errors/errors.hpp"
+#include "image/denoise.hpp"
 
 namespace wt::app {
 
@@ -206,10 +207,17 @@ class ContextStart {
 // nothing, and no output may overwrite another. Of an MPI run, rank 0 alone writes
 // (and keeps no checkpoint).
 void check_outputs(const Job& job, bool distributed) {
+  if (job.keep_noisy && !job.denoise) throw InputError("--keep-noisy: keeps the render beside a denoised image: give --denoise too");
+  if (job.denoise) {
+    std::string why;
+    if (!oidn_available(why)) throw InputError("--denoise: " + why);
+  }
   check_output_path(job.output);
+  if (!noisy_output(job).empty()) check_output_path(noisy_output(job));
   if (!job.stats.empty()) check_output_path_for_text(job.stats);
   check_distinct_files(job);
   check_creatable(job.output, "image");
+  if (!noisy_output(job).empty()) check_creatable(noisy_output(job), "noisy image");
   if (!job.stats.empty()) check_creatable(job.stats, "stats file");
   if (!distributed && !checkpoint_of(job).empty()) {
     check_output_folder(checkpoint_of(job));
@@ -375,14 +383,38 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   warn_nonfinite(job, out);
   // Both files are written in full before either takes its name: a disk that fills
   // up during the second leaves neither.
+  const int w = options.params.width, h = options.params.height;
+  const ExrPixels exr = job.exr_float ? ExrPixels::Float : ExrPixels::Half;
+  // A denoised job's output is the denoiser's image (on the CUDA device where the
+  // render ran on one), the render itself its noisy image where kept.
+  std::vector<float> denoised;
+  if (job.denoise) {
+    const auto start = std::chrono::steady_clock::now();
+    DenoiseDevice device = options.backend == Backend::Cuda ? DenoiseDevice::Cuda : DenoiseDevice::Cpu;
+    const DenoiseQuality quality = job.denoise_quality == "balanced" ? DenoiseQuality::Balanced : DenoiseQuality::High;
+    try {
+      denoised = denoise({w, h, out.result.rgb.data()}, quality, device);
+    } catch (const DeviceError& e) {
+      if (device == DenoiseDevice::Cpu) throw;
+      // OIDN without its CUDA device here (a driver it does not take, a module not
+      // installed): the CPU's, said on stderr.
+      std::fprintf(stderr, "wavetrace: %s; denoising on the CPU\n", e.what());
+      device = DenoiseDevice::Cpu;
+      denoised = denoise({w, h, out.result.rgb.data()}, quality, device);
+    }
+    out.denoise_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out.denoise_device = device == DenoiseDevice::Cuda ? "cuda" : "cpu";
+  }
   const auto write_start = std::chrono::steady_clock::now();
-  StagedFile image = stage_image(job.output, options.params.width, options.params.height, out.result.rgb,
-                                 job.encoding, job.exr_float ? ExrPixels::Float : ExrPixels::Half);
+  StagedFile image = stage_image(job.output, w, h, job.denoise ? denoised : out.result.rgb, job.encoding, exr);
+  StagedFile noisy =
+      noisy_output(job).empty() ? StagedFile() : stage_image(noisy_output(job), w, h, out.result.rgb, job.encoding, exr);
   const auto written = std::chrono::steady_clock::now();
   out.write_seconds = std::chrono::duration<double>(written - write_start).count();
   out.job_seconds = std::chrono::duration<double>(written - job_start).count();
   StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
   image.commit();
+  noisy.commit();
   stats.commit();
   // The image is written: the checkpoint has served its purpose.
   if (!out.checkpoint.empty()) std::filesystem::remove(out.checkpoint);

@@ -35,6 +35,12 @@ struct Job {
   int64_t checkpoint_every = 300;
   Encoding encoding = Encoding::Srgb;
   bool exr_float = false;  // an .exr output's pixels: 32-bit floats rather than half floats
+  // Denoising (image/denoise.hpp): the output is the image Open Image Denoise makes
+  // of the render, at `denoise_quality` ("high" or "balanced"); with keep_noisy the
+  // render itself is written too, as noisy_output(job) (NAME.noisy.EXT).
+  bool denoise = false;
+  std::string denoise_quality = "high";
+  bool keep_noisy = false;
   bool progress = true;
   bool profile = false;
 };
@@ -64,6 +70,10 @@ struct JobOutcome {
   // Wall clock of the whole job up to its image written, from the start of run_job
   // (scene, device set-up, render, image), and of encoding and writing the image.
   double job_seconds = 0, write_seconds = 0;
+  // Of a denoised job: Open Image Denoise's seconds (its device set-up, the filter and
+  // the copies), and the device it ran on ("cpu" or "cuda").
+  double denoise_seconds = 0;
+  std::string denoise_device;
   // Pixels of the image that are not finite (a NaN or an infinity in any channel): said
   // on stderr and in the stats, never written silently.
   uint64_t nonfinite_pixels = 0;

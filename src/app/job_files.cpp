@@ -39,12 +39,19 @@ std::string file_key(const std::string& path) {
   return resolved_path(path);
 }
 
+std::string noisy_output(const Job& job) {
+  if (!job.denoise || !job.keep_noisy || job.output.empty()) return "";
+  const std::filesystem::path p(job.output);
+  return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
+}
+
 std::vector<JobFile> job_files(const Job& job) {
   std::vector<JobFile> files;
   const auto add = [&](const char* field, const std::string& path, bool written) {
     if (!path.empty()) files.push_back({field, path, written});
   };
   add("output", job.output, true);
+  add("noisy output", noisy_output(job), true);
   add("stats", job.stats, true);
   add("checkpoint", job.checkpoint, true);
   // Without --checkpoint the resume file is written back to.

@@ -19,9 +19,14 @@ struct JobFile {
   bool written = true;  // false: only read (the scene; a resume file that no checkpoint is written back to)
 };
 
-// The job's files: the image, the stats file, the checkpoint it writes (--checkpoint,
-// or the --resume file written back to), the resume file it reads, and the scene.
+// The job's files: the image, the noisy image (--keep-noisy), the stats file, the
+// checkpoint it writes (--checkpoint, or the --resume file written back to), the
+// resume file it reads, and the scene.
 std::vector<JobFile> job_files(const Job& job);
+
+// Where a denoised job's render itself goes with --keep-noisy: NAME.noisy.EXT beside
+// the output NAME.EXT. Empty where the job keeps none.
+std::string noisy_output(const Job& job);
 
 // The same file for any two spellings of it: the absolute path with every link of
 // its existing part resolved and "." and ".." removed, or for a file that exists its

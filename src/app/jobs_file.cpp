@@ -24,8 +24,8 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 // The keys of a job (and of "defaults"): the files, then every setting of the table.
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
-    std::vector<std::string> k = {"scene", "output", "stats", "checkpoint", "resume", "backend", "kernel", "encoding",
-                                  "exr_float"};
+    std::vector<std::string> k = {"scene",    "output",    "stats",    "checkpoint",      "resume",    "backend",
+                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -57,6 +57,12 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.encoding = r.choice(value, at, encoding_choices()) == 0 ? Encoding::Srgb : Encoding::Gamma2;
     } else if (key == "exr_float") {
       job.exr_float = r.boolean(value, at);
+    } else if (key == "denoise") {
+      job.denoise = r.boolean(value, at);
+    } else if (key == "denoise_quality") {
+      job.denoise_quality = denoise_quality_choices()[r.choice(value, at, denoise_quality_choices())];
+    } else if (key == "keep_noisy") {
+      job.keep_noisy = r.boolean(value, at);
     } else {
       for (const Setting& s : settings()) {
         if (key == s.key) set_setting(job, s.id, r.integer(value, at, s.lo, s.hi));

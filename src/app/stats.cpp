@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "app/job_files.hpp"
 #include "errors/errors.hpp"
 
 namespace wt::app {
@@ -122,6 +123,10 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["timer"] = o.backend == "cuda" ? "cuda events" : "wall clock";
   j["job_seconds"] = o.job_seconds;
   j["write_seconds"] = o.write_seconds;
+  if (job.denoise) {
+    j["denoise"] = {{"quality", job.denoise_quality}, {"device", o.denoise_device}, {"seconds", o.denoise_seconds}};
+    if (job.keep_noisy) j["noisy_output"] = noisy_output(job);
+  }
   add_measurements(j, r, r.seconds, o.load_times);
   j["geometry"] = geometry_json(o.geometry);
   return j;

@@ -59,10 +59,13 @@ std::string executable_dir() {
 std::vector<std::string> candidates() {
   constexpr const char* kName = "libOpenImageDenoise.so.2";
   std::vector<std::string> out;
+  // Where the environment names one, that one alone: a user may pin a version (or
+  // name none, to render as a machine without it would).
   if (const char* env = std::getenv("WAVETRACE_OIDN"); env != nullptr && *env != '\0') {
     std::error_code ec;
     out.push_back(std::filesystem::is_directory(env, ec) ? (std::filesystem::path(env) / kName).string()
                                                          : std::string(env));
+    return out;
   }
   if (const std::string dir = executable_dir(); !dir.empty()) out.push_back(dir + "/oidn/" + kName);
   if (*WT_OIDN_PROJECT_DIR != '\0') out.push_back(std::string(WT_OIDN_PROJECT_DIR) + "/" + kName);

@@ -2,7 +2,8 @@
 // does not denoise never needs it. Its C API is declared here from OIDN's
 // documentation (the library ships without headers in the wheel the set-up script
 // fetches), and the library is looked for, in this order, at
-//   - $WAVETRACE_OIDN: a folder holding libOpenImageDenoise.so.2, or that file;
+//   - $WAVETRACE_OIDN: a folder holding libOpenImageDenoise.so.2, or that file (where
+//     it is set, nowhere else);
 //   - oidn/ beside the running executable (a bundle carried with the binaries);
 //   - the project's .deps/oidn/lib, where scripts/setup.sh unpacks the `pyoidn`
 //     wheel's libraries;

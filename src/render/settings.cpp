@@ -147,4 +147,9 @@ const std::vector<std::string>& encoding_choices() {
   return names;
 }
 
+const std::vector<std::string>& denoise_quality_choices() {
+  static const std::vector<std::string> names = {"high", "balanced"};
+  return names;
+}
+
 }  // namespace wt

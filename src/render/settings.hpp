@@ -69,5 +69,7 @@ Kernel parse_kernel(const std::string& name);  // throws InputError naming the k
 // the PNG encodings.
 const std::vector<std::string>& backend_choices();
 const std::vector<std::string>& encoding_choices();
+// Open Image Denoise's qualities that --denoise-quality takes (image/denoise.hpp).
+const std::vector<std::string>& denoise_quality_choices();
 
 }  // namespace wt
