@@ -364,12 +364,12 @@ bump tex/h.png
   EXPECT_EQ(pbr->bump_map.image, at_root("tex/normal.png"));
   EXPECT_FLOAT_EQ(pbr->bump_scale, 0.3f);
   EXPECT_EQ(pbr->bump_channel, 'l');
-  EXPECT_TRUE(pbr->bump_may_be_normal_map);
+  EXPECT_TRUE(pbr->bump_may_be_normal_map());
   EXPECT_EQ(classic->material.kind, MaterialKind::Lambertian);
   EXPECT_EQ(classic->bump_map.image, at_root("tex/height.png"));
   EXPECT_FLOAT_EQ(classic->bump_scale, -2.0f);
   EXPECT_EQ(red->bump_channel, 'r');
-  EXPECT_FALSE(red->bump_may_be_normal_map);
+  EXPECT_FALSE(red->bump_may_be_normal_map());
   EXPECT_EQ(both->normal_map.image, at_root("tex/n.png"));
   EXPECT_FLOAT_EQ(both->normal_scale, 1.0f);
   EXPECT_TRUE(both->bump_map.empty());

@@ -42,12 +42,7 @@ struct BsdfInputs {
 WT_HD WT_INLINE vec3 bumped_normal(const vec3& n, const SurfacePoint& sp, const Texture& t, const vec3& texel,
                                    float scale) {
   const vec2 g(t.uv_cos * texel.x - t.uv_sin * texel.y, t.uv_sin * texel.x + t.uv_cos * texel.y);
-  vec2 rate(sp.uv_density);
-  if (!sp.has_uv) {
-    const float r = sqrtf(glm::dot(sp.local, sp.local));
-    const float sin_theta = fmaxf(sqrtf(fmaxf(1.0f - sp.n.y * sp.n.y, 0.0f)), 1e-4f);
-    rate = r > 0.0f ? vec2(0.5f / (kPi * r * sin_theta), 1.0f / (kPi * r)) : vec2(0.0f);
-  }
+  const vec2 rate = sp.has_uv ? vec2(sp.uv_density) : sphere_uv_rates(sp);
   const vec2 slope = scale * g * t.uv_scale * rate;  // d's derivatives along u and v, per unit length
   // B times tangent_sign points towards decreasing v.
   const Frame f = Frame::about(n, sp.dpdu);

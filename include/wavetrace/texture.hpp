@@ -223,10 +223,24 @@ WT_HD WT_INLINE vec2 sphere_uv(const vec3& n) {
 // u runs once around a circle of radius r sin(theta), v once from pole to pole, so
 // the square root of (du/dl)(dv/dl) is 1 / (pi r sqrt(2 sin theta)); sin theta is
 // kept above 1e-4 at the poles, where u's circles shrink to a point.
+// The sphere's radius at sp and sin(theta) of its point, kept above 1e-4.
+WT_HD WT_INLINE void sphere_radius_and_sin_theta(const SurfacePoint& sp, float& r, float& sin_theta) {
+  r = sqrtf(glm::dot(sp.local, sp.local));
+  sin_theta = fmaxf(sqrtf(fmaxf(1.0f - sp.n.y * sp.n.y, 0.0f)), 1e-4f);
+}
+
 WT_HD WT_INLINE float sphere_uv_density(const SurfacePoint& sp) {
-  const float r = sqrtf(glm::dot(sp.local, sp.local));
-  const float sin_theta = fmaxf(sqrtf(fmaxf(1.0f - sp.n.y * sp.n.y, 0.0f)), 1e-4f);
+  float r, sin_theta;
+  sphere_radius_and_sin_theta(sp, r, sin_theta);
   return r > 0.0f ? 1.0f / (kPi * r * sqrtf(2.0f * sin_theta)) : 0.0f;
+}
+
+// The same mapping's UV units per unit length along u and along v apart:
+// 1 / (2 pi r sin theta) and 1 / (pi r).
+WT_HD WT_INLINE vec2 sphere_uv_rates(const SurfacePoint& sp) {
+  float r, sin_theta;
+  sphere_radius_and_sin_theta(sp, r, sin_theta);
+  return r > 0.0f ? vec2(0.5f / (kPi * r * sin_theta), 1.0f / (kPi * r)) : vec2(0.0f);
 }
 
 // An image texture's level of detail at sp: log2 of the pixel's footprint there in

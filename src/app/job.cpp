@@ -212,12 +212,13 @@ void check_outputs(const Job& job, bool distributed) {
     std::string why;
     if (!oidn_available(why)) throw InputError("--denoise: " + why);
   }
+  const std::string noisy = noisy_output(job);
   check_output_path(job.output);
-  if (!noisy_output(job).empty()) check_output_path(noisy_output(job));
+  if (!noisy.empty()) check_output_path(noisy);
   if (!job.stats.empty()) check_output_path_for_text(job.stats);
   check_distinct_files(job);
   check_creatable(job.output, "image");
-  if (!noisy_output(job).empty()) check_creatable(noisy_output(job), "noisy image");
+  if (!noisy.empty()) check_creatable(noisy, "noisy image");
   if (!job.stats.empty()) check_creatable(job.stats, "stats file");
   if (!distributed && !checkpoint_of(job).empty()) {
     check_output_folder(checkpoint_of(job));
@@ -407,8 +408,9 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   }
   const auto write_start = std::chrono::steady_clock::now();
   StagedFile image = stage_image(job.output, w, h, job.denoise ? denoised : out.result.rgb, job.encoding, exr);
+  const std::string noisy_path = noisy_output(job);
   StagedFile noisy =
-      noisy_output(job).empty() ? StagedFile() : stage_image(noisy_output(job), w, h, out.result.rgb, job.encoding, exr);
+      noisy_path.empty() ? StagedFile() : stage_image(noisy_path, w, h, out.result.rgb, job.encoding, exr);
   const auto written = std::chrono::steady_clock::now();
   out.write_seconds = std::chrono::duration<double>(written - write_start).count();
   out.job_seconds = std::chrono::duration<double>(written - job_start).count();

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "wavetrace/texture.hpp"
+
 namespace wt {
 
 namespace {
@@ -18,14 +20,13 @@ float height_of(const float* texel, HeightChannel channel) {
 }
 
 // h's derivative at index i of n along one axis, per unit of the coordinate (n
-// texels), from the texels either side (get(j)).
+// texels), from the texels either side (get(j)) as the wrap finds them: a
+// neighbour the wrap puts back on i (an edge of Clamp or Mirror) is no step.
 template <class Get>
 float derivative(int i, int n, Wrap wrap, const Get& get) {
-  if (n < 2) return 0.0f;
-  const bool joined = wrap == Wrap::Repeat;  // the last texel's neighbour is the first
-  const int before = i > 0 || joined ? 1 : 0, after = i < n - 1 || joined ? 1 : 0;
-  const int lo = before ? (i - 1 + n) % n : i, hi = after ? (i + 1) % n : i;
-  return (get(hi) - get(lo)) * static_cast<float>(n) / static_cast<float>(before + after);
+  const int lo = wrap_index(i - 1, n, wrap), hi = wrap_index(i + 1, n, wrap);
+  const int steps = (lo != i ? 1 : 0) + (hi != i ? 1 : 0);
+  return steps == 0 ? 0.0f : (get(hi) - get(lo)) * static_cast<float>(n) / static_cast<float>(steps);
 }
 
 }  // namespace

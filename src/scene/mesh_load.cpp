@@ -368,7 +368,6 @@ MeshMaterial map_mtl(const tinyobj::material_t& t, const MtlKeys& k, const fs::p
       const char c = t.bump_texopt.imfchan;
       if (c == 'z') warn(std::string(bump_key) + " -imfchan z is not honoured: its heights are the image's luminance");
       out.bump_channel = c == 'r' || c == 'g' || c == 'b' || c == 'm' ? c : 'l';
-      out.bump_may_be_normal_map = out.bump_channel == 'l';
     }
   }
 

@@ -66,7 +66,7 @@ struct MeshMaterial {
   MeshTexture bump_map;
   float bump_scale = 1.0f;
   char bump_channel = 'l';
-  bool bump_may_be_normal_map = true;
+  bool bump_may_be_normal_map() const { return bump_channel == 'l'; }
   // KHR_materials_clearcoat (MTL's Pc, Pcr): the coat's weight and roughness, times
   // clearcoat_map's R and clearcoat_roughness_map's G; the coat's own normal map
   // (none: the coat follows the surface, not the base's normal map).

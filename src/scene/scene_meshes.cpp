@@ -110,7 +110,7 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
       auto add_bump = [&](MaterialParams& p) {
         if (mm.bump_map.empty()) return;
         const Texture heights = texture_for(mm.bump_map, false);
-        if (mm.bump_may_be_normal_map && reads_as_normal_map(scene_.images[static_cast<size_t>(heights.image)])) {
+        if (mm.bump_may_be_normal_map() && reads_as_normal_map(scene_.images[static_cast<size_t>(heights.image)])) {
           scene_.textures.push_back(heights);
           p.normal_texture = static_cast<int32_t>(scene_.textures.size() - 1);
           p.normal_strength = mm.bump_scale;
