@@ -5,7 +5,9 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${WAVETRACE_BUILD:-$root/build}
 bash "$root/scripts/setup.sh"
+source "$root/scripts/cuda-arch.sh"
 if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" >/dev/null
 fi
+cuda_arch_configure "$build"
 cmake --build "$build" --parallel "$(nproc)"

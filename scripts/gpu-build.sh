@@ -1,9 +1,12 @@
 #!/usr/bin/env bash
 # Builds the binaries for a GPU machine that cannot build (no packages there) into
-# .gpu/bin, a folder git ignores, with a build-info.json that names the commit.
+# .gpu/bin, a folder git ignores, with a build-info.json that names the commit. Its
+# own build folder, build-gpu/, holds machine code for the GPU (sm_90: H100, H200),
+# where build/ on a machine without a GPU holds PTX only (scripts/cuda-arch.sh).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-export WAVETRACE_BUILD=${WAVETRACE_BUILD:-$root/build}
+export WAVETRACE_BUILD=${WAVETRACE_BUILD:-$root/build-gpu}
+export WAVETRACE_CUDA_ARCH=${WAVETRACE_CUDA_ARCH:-90}
 bash "$root/scripts/build.sh"
 mkdir -p "$root/.gpu/bin"
 cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$WAVETRACE_BUILD/wavetrace-gltf-tiles" "$root/.gpu/bin/"

@@ -12,13 +12,15 @@ sanitize=(-fsanitize=address -fsanitize=undefined -fno-sanitize-recover=all -fno
 # The mutants of mutation testing are compiled in (include/wavetrace/mutant.hpp; none
 # is active unless WAVETRACE_MUTANT names one), so that CI's mutants run in this
 # build instead of a third one.
+source "$root/scripts/cuda-arch.sh"
 if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" \
     -DCMAKE_CXX_FLAGS="${sanitize[*]}" \
     -DCMAKE_CUDA_FLAGS="${sanitize[*]/#/-Xcompiler=}" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address -fsanitize=undefined" >/dev/null
 fi
 cmake -S "$root" -B "$build" -DWAVETRACE_MUTANTS=ON >/dev/null
+cuda_arch_configure "$build"
 cmake --build "$build" --parallel "$(nproc)"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
