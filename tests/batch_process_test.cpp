@@ -34,7 +34,8 @@ namespace fs = std::filesystem;
 auto fields(const Job& j) {
   return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
                   j.kernel, j.warmup, j.wave_size, j.threads, j.devices, j.checkpoint, j.resume, j.checkpoint_every,
-                  j.encoding, j.exr_float, j.progress, j.profile, j.denoise, j.denoise_quality, j.keep_noisy);
+                  j.encoding, j.exr_float, j.progress, j.profile, j.denoise, j.denoise_quality, j.keep_noisy,
+                  j.aov);
 }
 
 
@@ -65,6 +66,7 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   every.denoise = true;
   every.denoise_quality = "balanced";
   every.keep_noisy = true;
+  every.aov = "position,albedo";
   Job defaults;
   defaults.scene = "s.json";
   defaults.output = "o.png";

@@ -73,6 +73,20 @@ WT_HD WT_INLINE vec3 emitted_radiance(const Scene& scene, const Material& m, con
   }
 }
 
+// The BSDF of material m at sp, reached along `ray`: its textures filtered over the
+// camera's footprint there (texture_lod), which is set in sp.
+template <uint32_t Kinds, class Scene>
+WT_HD WT_INLINE BsdfAt bsdf_at_hit(const Scene& scene, const Material& m, const Ray& ray, SurfacePoint& sp) {
+  constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
+  constexpr bool kLayers = kFacets && (Kinds & kLayersAndAlpha) != 0;
+  if constexpr (kFacets) {
+    if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+  }
+  return bsdf_at<kFacets, kLayers>(
+      m, BsdfInputs{scene.material_param_array(), scene.bsdf_table_array(), scene.texture_array(), scene.image_array()},
+      sp, material_albedo<kFacets>(m, scene.texture_array(), scene.image_array(), sp), -ray.dir);
+}
+
 // A light sample's contribution, waiting for its shadow ray: added to the film
 // where nothing blocks `ray` before tmax.
 struct ShadowRay {
@@ -217,15 +231,9 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
       }
     }
   }
-  // The footprint that filters the material's image textures (texture_lod).
-  if constexpr (kFacets) {
-    if (m.texture >= 0 || m.params >= 0) sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
-  }
   Rng rng = Rng::at(rp.seed, pixel, sample, bounce);
   const vec3 wo = -ray.dir;
-  const BsdfAt bsdf = bsdf_at<kFacets, kLayers>(
-      m, BsdfInputs{scene.material_param_array(), scene.bsdf_table_array(), scene.texture_array(), scene.image_array()},
-      sp, material_albedo<kFacets>(m, scene.texture_array(), scene.image_array(), sp), wo);
+  const BsdfAt bsdf = bsdf_at_hit<Kinds>(scene, m, ray, sp);
   // A light sample here stands for the path's next ray hitting the emitter, so it
   // is taken only where that ray could still be traced: with and without light
   // sampling the render estimates the same paths.

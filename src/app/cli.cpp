@@ -30,6 +30,9 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
   cmd.add_option("--denoise-quality", job.denoise_quality, "the denoiser's quality: high (default) or balanced")
       ->check(CLI::IsMember(denoise_quality_choices()));
   cmd.add_flag("--keep-noisy", job.keep_noisy, "with --denoise: write the render itself too, as NAME.noisy.EXT");
+  cmd.add_option("--aov", job.aov,
+                 "write these AOVs too, comma-separated: " + listed(aov_names()) +
+                     " (layers of an .exr output, else NAME.<aov>.pfm beside it)");
 }
 
 void set_encoding(Job& job, const std::string& encoding) {
@@ -81,6 +84,7 @@ std::vector<std::string> render_arguments(const Job& job) {
     add("--denoise-quality", job.denoise_quality);
   }
   if (job.keep_noisy) args.push_back("--keep-noisy");
+  add("--aov", job.aov);
   if (!job.progress) args.push_back("--quiet");
   if (job.profile) args.push_back("--profile");
   args.push_back("--");  // the scene, whatever its name

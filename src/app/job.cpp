@@ -213,12 +213,15 @@ void check_outputs(const Job& job, bool distributed) {
     if (!oidn_available(why)) throw InputError("--denoise: " + why);
   }
   const std::string noisy = noisy_output(job);
+  const std::vector<JobFile> aovs = aov_outputs(job);  // the --aov list checked
   check_output_path(job.output);
   if (!noisy.empty()) check_output_path(noisy);
+  for (const JobFile& f : aovs) check_output_path(f.path);
   if (!job.stats.empty()) check_output_path_for_text(job.stats);
   check_distinct_files(job);
   check_creatable(job.output, "image");
   if (!noisy.empty()) check_creatable(noisy, "noisy image");
+  for (const JobFile& f : aovs) check_creatable(f.path, f.field);
   if (!job.stats.empty()) check_creatable(job.stats, "stats file");
   if (!distributed && !checkpoint_of(job).empty()) {
     check_output_folder(checkpoint_of(job));
@@ -390,24 +393,43 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   // render ran on one), the render itself its noisy image where kept.
   std::vector<float> denoised;
   if (job.denoise) {
+    // Guided by the albedo and the normal of the first-surface pass.
+    const std::vector<float> albedo = denoise_albedo(out.aovs.sums, out.aovs.samples);
+    const std::vector<float> normal = denoise_normal(out.aovs.sums, out.aovs.samples);
     const auto start = std::chrono::steady_clock::now();
     DenoiseDevice device = options.backend == Backend::Cuda ? DenoiseDevice::Cuda : DenoiseDevice::Cpu;
     const DenoiseQuality quality = job.denoise_quality == "balanced" ? DenoiseQuality::Balanced : DenoiseQuality::High;
     try {
-      denoised = denoise({w, h, out.result.rgb.data()}, quality, device);
+      denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
     } catch (const DeviceError& e) {
       if (device == DenoiseDevice::Cpu) throw;
       // OIDN without its CUDA device here (a driver it does not take, a module not
       // installed): the CPU's, said on stderr.
       std::fprintf(stderr, "wavetrace: %s; denoising on the CPU\n", e.what());
       device = DenoiseDevice::Cpu;
-      denoised = denoise({w, h, out.result.rgb.data()}, quality, device);
+      denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
     }
     out.denoise_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     out.denoise_device = device == DenoiseDevice::Cuda ? "cuda" : "cpu";
   }
   const auto write_start = std::chrono::steady_clock::now();
-  StagedFile image = stage_image(job.output, w, h, job.denoise ? denoised : out.result.rgb, job.encoding, exr);
+  // The AOVs: layers of an OpenEXR output, else files of their own beside it.
+  std::vector<AovImage> aovs;
+  if (!job.aov.empty()) {
+    for (AovKind k : parse_aovs(job.aov)) aovs.push_back(aov_image(k, out.aovs.sums, out.aovs.samples));
+  }
+  const std::vector<JobFile> aov_files = aov_outputs(job);
+  std::vector<ImageLayer> layers;
+  if (aov_files.empty()) {
+    for (const AovImage& a : aovs) layers.push_back({a.name, a.channels, &a.values});
+  }
+  StagedFile image =
+      stage_image(job.output, w, h, job.denoise ? denoised : out.result.rgb, job.encoding, exr, layers);
+  std::vector<StagedFile> aov_staged;
+  for (size_t i = 0; i < aov_files.size(); ++i) {
+    aov_staged.push_back(stage_pfm_image(aov_files[i].path, w, h, aovs[i].values,
+                                         static_cast<int>(aovs[i].channels.size())));
+  }
   const std::string noisy_path = noisy_output(job);
   StagedFile noisy =
       noisy_path.empty() ? StagedFile() : stage_image(noisy_path, w, h, out.result.rgb, job.encoding, exr);
@@ -417,6 +439,7 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   StagedFile stats = job.stats.empty() ? StagedFile() : stage_file(job.stats, stats_json(job, out).dump(2) + "\n");
   image.commit();
   noisy.commit();
+  for (StagedFile& f : aov_staged) f.commit();
   stats.commit();
   // The image is written: the checkpoint has served its purpose.
   if (!out.checkpoint.empty()) std::filesystem::remove(out.checkpoint);
@@ -462,6 +485,9 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   if (out.exit_code != 0 || !cluster.root()) return out;
   guarded(out, [&] {
     if (distributed) take_mean(out.result);
+    // The AOVs and the denoiser's guides: one first-surface pass over the whole
+    // render's samples, whatever kernel, checkpoint or ranks made the image.
+    if (!job.aov.empty() || job.denoise) out.aovs = render_aovs(*scene, options);
     write_job(job, options, out, job_start);
   });
   return out;

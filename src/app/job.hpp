@@ -41,6 +41,9 @@ struct Job {
   bool denoise = false;
   std::string denoise_quality = "high";
   bool keep_noisy = false;
+  // AOVs (render/aovs.hpp) as --aov names them ("albedo,normal"; empty: none): layers
+  // of an OpenEXR output, else PFM files beside it (aov_outputs in job_files.hpp).
+  std::string aov;
   bool progress = true;
   bool profile = false;
 };
@@ -74,6 +77,9 @@ struct JobOutcome {
   // the copies), and the device it ran on ("cpu" or "cuda").
   double denoise_seconds = 0;
   std::string denoise_device;
+  // The first-surface pass's sums, for the AOVs and the denoiser's guides (empty
+  // where the job asks for neither).
+  AovSums aovs;
   // Pixels of the image that are not finite (a NaN or an infinity in any channel): said
   // on stderr and in the stats, never written silently.
   uint64_t nonfinite_pixels = 0;

@@ -45,6 +45,19 @@ std::string noisy_output(const Job& job) {
   return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
 }
 
+std::vector<JobFile> aov_outputs(const Job& job) {
+  std::vector<JobFile> files;
+  if (job.aov.empty() || job.output.empty()) return files;
+  const std::vector<AovKind> kinds = parse_aovs(job.aov);
+  const std::filesystem::path p(job.output);
+  if (p.extension() == ".exr") return files;
+  for (AovKind k : kinds) {
+    files.push_back({std::string(aov_name(k)) + " AOV",
+                     (p.parent_path() / (p.stem().string() + "." + aov_name(k) + ".pfm")).string(), true});
+  }
+  return files;
+}
+
 std::vector<JobFile> job_files(const Job& job) {
   std::vector<JobFile> files;
   const auto add = [&](const char* field, const std::string& path, bool written) {
@@ -52,6 +65,7 @@ std::vector<JobFile> job_files(const Job& job) {
   };
   add("output", job.output, true);
   add("noisy output", noisy_output(job), true);
+  for (const JobFile& f : aov_outputs(job)) files.push_back(f);
   add("stats", job.stats, true);
   add("checkpoint", job.checkpoint, true);
   // Without --checkpoint the resume file is written back to.

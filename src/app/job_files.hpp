@@ -28,6 +28,11 @@ std::vector<JobFile> job_files(const Job& job);
 // the output NAME.EXT. Empty where the job keeps none.
 std::string noisy_output(const Job& job);
 
+// Where each AOV the job asks for goes, as its field ("albedo AOV") and path:
+// NAME.<aov>.pfm beside an output NAME.EXT that is not OpenEXR, whose AOVs are its
+// layers (none here). Throws InputError for a list --aov does not take.
+std::vector<JobFile> aov_outputs(const Job& job);
+
 // The same file for any two spellings of it: the absolute path with every link of
 // its existing part resolved and "." and ".." removed, or for a file that exists its
 // device and inode (hard links). Never throws.

@@ -25,7 +25,7 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k = {"scene",    "output",    "stats",    "checkpoint",      "resume",    "backend",
-                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy"};
+                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy", "aov"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -63,6 +63,13 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.denoise_quality = denoise_quality_choices()[r.choice(value, at, denoise_quality_choices())];
     } else if (key == "keep_noisy") {
       job.keep_noisy = r.boolean(value, at);
+    } else if (key == "aov") {
+      job.aov = r.string(value, at);
+      try {
+        parse_aovs(job.aov, "");
+      } catch (const InputError& e) {
+        r.fail_at(at, e.what());
+      }
     } else {
       for (const Setting& s : settings()) {
         if (key == s.key) set_setting(job, s.id, r.integer(value, at, s.lo, s.hi));

@@ -127,6 +127,21 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
     j["denoise"] = {{"quality", job.denoise_quality}, {"device", o.denoise_device}, {"seconds", o.denoise_seconds}};
     if (job.keep_noisy) j["noisy_output"] = noisy_output(job);
   }
+  if (!job.aov.empty() || job.denoise) {
+    // The first-surface pass: the AOVs asked for and the denoiser's guides.
+    nlohmann::json aovs = {{"seconds", o.aovs.seconds}, {"samples", o.aovs.samples}, {"names", nlohmann::json::array()}};
+    if (!job.aov.empty()) {
+      for (AovKind k : parse_aovs(job.aov)) aovs["names"].push_back(aov_name(k));
+    }
+    const std::vector<JobFile> files = aov_outputs(job);
+    if (!files.empty()) {
+      aovs["files"] = nlohmann::json::array();
+      for (const JobFile& f : files) aovs["files"].push_back(f.path);
+    } else if (!job.aov.empty()) {
+      aovs["layers_of"] = job.output;
+    }
+    j["aovs"] = aovs;
+  }
   add_measurements(j, r, r.seconds, o.load_times);
   j["geometry"] = geometry_json(o.geometry);
   return j;

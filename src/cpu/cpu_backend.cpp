@@ -10,6 +10,7 @@
 #include "errors/errors.hpp"
 #include "render/passes.hpp"
 #include "render/settings.hpp"
+#include "wavetrace/aov.hpp"
 #include "wavetrace/path.hpp"
 
 namespace wt::cpu {
@@ -112,6 +113,27 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   }
   out.device = "CPU (" + std::to_string(thread_count(options.threads)) + " threads)";
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
+  return out;
+}
+
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
+  const RenderParams& rp = options.params;
+  std::vector<ImageView> images;
+  const SceneView view = host_view(scene, rp.width, rp.height, images);
+  const int64_t pixels = static_cast<int64_t>(rp.width) * rp.height;
+  AovSums out;
+  out.samples = rp.spp;
+  out.sums.assign(static_cast<size_t>(pixels) * kAovFloats, 0.0f);
+  const auto t0 = Clock::now();
+  parallel_for(pixels, rp.width, thread_count(options.threads), [&](int64_t begin, int64_t end, int) {
+    for (int64_t px = begin; px < end; ++px) {
+      float* sums = out.sums.data() + px * kAovFloats;
+      for (int32_t s = 0; s < rp.spp; ++s) {
+        add_first_surface(sums, first_surface(view, rp, static_cast<uint32_t>(px), static_cast<uint32_t>(s)));
+      }
+    }
+  });
+  out.seconds = seconds_since(t0);
   return out;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 
+#include "render/aovs.hpp"
 #include "render/device_renderer.hpp"
 #include "render/render_types.hpp"
 #include "scene/scene.hpp"
@@ -17,5 +18,9 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // Host "device" i of the render's several (the split's logic without GPUs): a share
 // of the threads, rendering each chunk as render does.
 DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t i);
+
+// The first-surface pass (include/wavetrace/aov.hpp) over every sample of every
+// pixel, on host threads: the sums the AOVs are made of.
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options);
 
 }  // namespace wt::cpu

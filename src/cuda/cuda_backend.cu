@@ -8,12 +8,14 @@
 #include <string>
 
 #include "cuda/buffer.hpp"
+#include "cuda/cuda_aovs.hpp"
 #include "cuda/cuda_wavefront.hpp"
 #include "cuda/device_scene.hpp"
 #include "cuda/event.hpp"
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "render/passes.hpp"
+#include "wavetrace/aov.hpp"
 
 namespace wt::cuda {
 
@@ -199,6 +201,25 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   const Uploaded uploaded(scene, options);
   RenderResult out = uploaded.render(options);
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
+  return out;
+}
+
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
+  constexpr const char* kAovStage = "aovs";
+  if (!options.devices.empty()) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
+  const RenderParams& rp = options.params;
+  const size_t floats = static_cast<size_t>(rp.width) * rp.height * kAovFloats;
+  const DeviceInfo info = device_info();
+  require_device_memory(rp, floats * sizeof(float) + scene.device_bytes(), info.free_memory, info.name);
+  const DeviceScene ds(scene, rp.width, rp.height);
+  DeviceBuffer<float> sums(floats, kAovStage);
+  AovSums out;
+  out.samples = rp.spp;
+  EventTimer timer(kAovStage);
+  timer.start();
+  launch_first_surface(ds.view(), rp, sums.get(), nullptr);
+  out.seconds = timer.stop();
+  out.sums = sums.download(kAovStage);
   return out;
 }
 

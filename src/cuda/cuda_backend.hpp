@@ -2,6 +2,7 @@
 
 #include <cstddef>
 
+#include "render/aovs.hpp"
 #include "render/device_renderer.hpp"
 #include "render/render_types.hpp"
 #include "scene/scene.hpp"
@@ -21,6 +22,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // (the split's thread for it), the scene uploaded there, and each chunk rendered
 // there, its sums kept in the device's memory until collected.
 DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t i);
+
+// The first-surface pass (include/wavetrace/aov.hpp) on the first of
+// options.devices (or the current device), over a scene uploaded for it: the sums
+// the AOVs are made of.
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options);
 
 // Device bytes a render with these settings needs beyond the scene itself.
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size);

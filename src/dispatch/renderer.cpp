@@ -65,6 +65,13 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
   return render_on_backend(scene, options);
 }
 
+AovSums render_aovs(const Scene& scene, const RenderOptions& options) {
+  validate_params(options.params);
+  if (options.backend == Backend::Cpu) return cpu::render_aov_sums(scene, options);
+  cuda::check_devices(options);
+  return cuda::render_aov_sums(scene, options);
+}
+
 void take_mean(RenderResult& r) {
   const float inv = 1.0f / static_cast<float>(r.samples);
   for (float& v : r.rgb) v *= inv;

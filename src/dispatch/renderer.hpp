@@ -2,6 +2,7 @@
 // radiance, counted rays and timings back.
 #pragma once
 
+#include "render/aovs.hpp"
 #include "render/render_types.hpp"
 #include "render/settings.hpp"
 #include "scene/scene.hpp"
@@ -18,6 +19,11 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
 // sums are added to others' (the ranks of an MPI run).
 RenderResult render_sums(const Scene& scene, const RenderOptions& options);
+
+// The first-surface pass that the AOVs are made of (render/aovs.hpp), over every
+// sample of every pixel, on the options' backend (the first of its devices): the same
+// for every kernel, since the pass follows the camera's rays and not a kernel's queues.
+AovSums render_aovs(const Scene& scene, const RenderOptions& options);
 
 // Turns a backend's pixel sums over r.samples samples into means (every render's
 // last step; also for a film that was complete when it was resumed).

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "errors/errors.hpp"
 
@@ -151,14 +153,14 @@ std::vector<float> denoise(const DenoiseImages& in, DenoiseQuality quality, Deno
   struct Objects {
     const Oidn& a;
     OIDNDevice device = nullptr;
-    OIDNFilter filter = nullptr;
+    std::vector<OIDNFilter> filters;
     std::vector<OIDNBuffer> buffers;
     ~Objects() {
-      if (filter) a.release_filter(filter);
+      for (OIDNFilter f : filters) a.release_filter(f);
       for (OIDNBuffer b : buffers) a.release_buffer(b);
       if (device) a.release_device(device);
     }
-  } o{a, nullptr, nullptr, {}};
+  } o{a, nullptr, {}, {}};
   auto check = [&](const char* call) {
     const char* message = nullptr;
     if (o.device && a.get_device_error(o.device, &message) != kOidnErrorNone) {
@@ -173,7 +175,7 @@ std::vector<float> denoise(const DenoiseImages& in, DenoiseQuality quality, Deno
   }
   a.commit_device(o.device);
   check("oidnCommitDevice");
-  auto image = [&](const char* name, const float* data) {
+  auto buffer = [&](const float* data) {
     OIDNBuffer b = a.new_buffer(o.device, bytes);
     check("oidnNewBuffer");
     o.buffers.push_back(b);
@@ -181,22 +183,41 @@ std::vector<float> denoise(const DenoiseImages& in, DenoiseQuality quality, Deno
       a.write_buffer(b, 0, bytes, data);
       check("oidnWriteBuffer");
     }
-    a.set_filter_image(o.filter, name, b, kOidnFormatFloat3, w, h, 0, 0, 0);
-    check("oidnSetFilterImage");
     return b;
   };
-  o.filter = a.new_filter(o.device, "RT");
-  check("oidnNewFilter");
-  image("color", in.color);
-  if (in.albedo) image("albedo", in.albedo);
-  if (in.normal) image("normal", in.normal);
-  OIDNBuffer output = image("output", nullptr);
-  a.set_filter_bool(o.filter, "hdr", true);
-  a.set_filter_int(o.filter, "quality", quality == DenoiseQuality::High ? kOidnQualityHigh : kOidnQualityBalanced);
-  a.commit_filter(o.filter);
-  check("oidnCommitFilter");
-  a.execute_filter(o.filter);
-  check("oidnExecuteFilter");
+  auto filter = [&](const std::vector<std::pair<const char*, OIDNBuffer>>& images, bool hdr, bool clean_aux) {
+    OIDNFilter f = a.new_filter(o.device, "RT");
+    check("oidnNewFilter");
+    o.filters.push_back(f);
+    for (const auto& [name, b] : images) {
+      a.set_filter_image(f, name, b, kOidnFormatFloat3, w, h, 0, 0, 0);
+      check("oidnSetFilterImage");
+    }
+    if (hdr) a.set_filter_bool(f, "hdr", true);
+    if (clean_aux) a.set_filter_bool(f, "cleanAux", true);
+    a.set_filter_int(f, "quality", quality == DenoiseQuality::High ? kOidnQualityHigh : kOidnQualityBalanced);
+    a.commit_filter(f);
+    check("oidnCommitFilter");
+    a.execute_filter(f);
+    check("oidnExecuteFilter");
+  };
+  // The guides are Monte Carlo estimates too: each is denoised in place first, by
+  // the RT filter given it alone, and the colour's filter then takes them as clean
+  // (OIDN's documented prefiltering, for the highest quality).
+  std::vector<std::pair<const char*, OIDNBuffer>> images = {{"color", buffer(in.color)}};
+  if (in.albedo) {
+    const OIDNBuffer albedo = buffer(in.albedo);
+    filter({{"albedo", albedo}, {"output", albedo}}, false, false);
+    images.push_back({"albedo", albedo});
+  }
+  if (in.normal) {
+    const OIDNBuffer normal = buffer(in.normal);
+    filter({{"normal", normal}, {"output", normal}}, false, false);
+    images.push_back({"normal", normal});
+  }
+  const OIDNBuffer output = buffer(nullptr);
+  images.push_back({"output", output});
+  filter(images, true, in.albedo != nullptr);
   std::vector<float> out(w * h * 3);
   a.read_buffer(output, 0, bytes, out.data());
   check("oidnReadBuffer");

@@ -24,7 +24,8 @@ enum class DenoiseDevice { Cpu, Cuda };
 
 // The filter's inputs: linear RGB, row-major, 3 floats a pixel, width x height
 // each. The colour is HDR radiance; albedo (in [0, 1]) and normal (world space,
-// unit or zero) are optional, the normal only with an albedo (OIDN's rule).
+// unit or zero) are optional, the normal only with an albedo (OIDN's rule). Guides
+// are taken as noisy: each is denoised on its own first (OIDN's prefiltering).
 struct DenoiseImages {
   int width = 0, height = 0;
   const float* color = nullptr;

@@ -42,6 +42,8 @@ unsigned char* deflate_for_png(unsigned char* data, int size, int* out_size, int
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <string>
+#include <type_traits>
 #include <utility>
 
 #include "cpu/parallel.hpp"
@@ -165,14 +167,15 @@ StagedFile stage_png(const std::string& path, int w, int h, const std::vector<fl
   return f.finish();
 }
 
-// PFM: a text header, then little-endian floats, bottom row first.
-StagedFile stage_pfm(const std::string& path, int w, int h, const std::vector<float>& rgb) {
+// PFM: a text header ("PF" for 3 channels, "Pf" for 1), then little-endian floats,
+// bottom row first.
+StagedFile stage_pfm(const std::string& path, int w, int h, const std::vector<float>& values, int channels = 3) {
   FileWriter f(path);
-  const std::string header = "PF\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
+  const std::string header =
+      std::string(channels == 1 ? "Pf" : "PF") + "\n" + std::to_string(w) + " " + std::to_string(h) + "\n-1.0\n";
   f.write(header.data(), header.size());
-  for (int y = h - 1; y >= 0; --y) {
-    f.write(rgb.data() + static_cast<size_t>(y) * w * 3, sizeof(float) * w * 3);
-  }
+  const size_t row = static_cast<size_t>(w) * channels;
+  for (int y = h - 1; y >= 0; --y) f.write(values.data() + static_cast<size_t>(y) * row, sizeof(float) * row);
   return f.finish();
 }
 
@@ -197,22 +200,39 @@ class ExrStream : public Imf::OStream {
   uint64_t position_ = 0;
 };
 
-// Channels R, G, B and A (= 1) of type T (float or half), ZIP-compressed, rows from the
-// top (the header's default line order). `rgb` holds width * height * 3 values of T.
+// One channel of an OpenEXR image: `values` holds it every `stride` floats, row
+// after row from the top.
+struct ExrChannel {
+  std::string name;
+  const float* values;
+  size_t stride;
+};
+
+// The channels, and A (= 1), each of type T (float or half), ZIP-compressed, rows from
+// the top (the header's default line order).
 template <typename T>
-void write_exr_pixels(Imf::OStream& stream, int w, int h, const T* rgb, Imf::PixelType type) {
+void write_exr_pixels(Imf::OStream& stream, int w, int h, const std::vector<ExrChannel>& channels,
+                      Imf::PixelType type) {
   Imf::Header header(w, h);
   Imf::FrameBuffer frame;
-  const char* const names[] = {"R", "G", "B"};
-  // An output file only reads its frame buffer.
-  char* const base = const_cast<char*>(reinterpret_cast<const char*>(rgb));
-  for (size_t c = 0; c < 3; ++c) {
-    header.channels().insert(names[c], Imf::Channel(type));
-    frame.insert(names[c],
-                 Imf::Slice(type, base + c * sizeof(T), sizeof(T) * 3, sizeof(T) * 3 * static_cast<size_t>(w)));
+  const size_t pixels = static_cast<size_t>(w) * static_cast<size_t>(std::max(h, 0));
+  // Float channels are read where they are (an output file only reads its frame
+  // buffer); half ones are rounded to nearest into buffers of their own.
+  std::vector<std::vector<T>> data;
+  data.reserve(channels.size() + 1);
+  for (const ExrChannel& c : channels) {
+    header.channels().insert(c.name, Imf::Channel(type));
+    if constexpr (std::is_same_v<T, float>) {
+      char* const base = const_cast<char*>(reinterpret_cast<const char*>(c.values));
+      frame.insert(c.name, Imf::Slice(type, base, sizeof(float) * c.stride, sizeof(float) * c.stride * w));
+    } else {
+      std::vector<T>& d = data.emplace_back(pixels);
+      for (size_t i = 0; i < pixels; ++i) d[i] = T(c.values[i * c.stride]);
+      frame.insert(c.name, Imf::Slice(type, reinterpret_cast<char*>(d.data()), sizeof(T), sizeof(T) * w));
+    }
   }
   // One row of ones serves every row (a row stride of 0).
-  std::vector<T> alpha(static_cast<size_t>(std::max(w, 0)), T(1.0f));
+  std::vector<T>& alpha = data.emplace_back(static_cast<size_t>(std::max(w, 0)), T(1.0f));
   header.channels().insert("A", Imf::Channel(type));
   frame.insert("A", Imf::Slice(type, reinterpret_cast<char*>(alpha.data()), sizeof(T), 0));
   Imf::OutputFile file(stream, header);  // its destructor writes the row offsets
@@ -227,15 +247,21 @@ std::string one_line(std::string text) {
   return text;
 }
 
-StagedFile stage_exr(const std::string& path, int w, int h, const std::vector<float>& rgb, ExrPixels pixels) {
+StagedFile stage_exr(const std::string& path, int w, int h, const std::vector<float>& rgb, ExrPixels pixels,
+                     const std::vector<ImageLayer>& layers) {
+  std::vector<ExrChannel> channels = {{"R", rgb.data(), 3}, {"G", rgb.data() + 1, 3}, {"B", rgb.data() + 2, 3}};
+  for (const ImageLayer& layer : layers) {
+    for (size_t c = 0; c < layer.channels.size(); ++c) {
+      channels.push_back({layer.name + "." + layer.channels[c], layer.values->data() + c, layer.channels.size()});
+    }
+  }
   FileWriter f(path);
   try {
     ExrStream stream(f, path);
     if (pixels == ExrPixels::Float) {
-      write_exr_pixels(stream, w, h, rgb.data(), Imf::FLOAT);  // the render's floats, in place
+      write_exr_pixels<float>(stream, w, h, channels, Imf::FLOAT);
     } else {
-      const std::vector<half> rgb_half(rgb.begin(), rgb.end());  // rounded to nearest
-      write_exr_pixels(stream, w, h, rgb_half.data(), Imf::HALF);
+      write_exr_pixels<half>(stream, w, h, channels, Imf::HALF);  // rounded to nearest
     }
   } catch (const Iex::BaseExc& e) {
     // A failed write of the file's bytes is reported by finish(), with the system's
@@ -297,13 +323,23 @@ void StagedFile::commit() {
 }
 
 StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
-                       Encoding encoding, ExrPixels exr) {
-  switch (format_of(path)) {
+                       Encoding encoding, ExrPixels exr, const std::vector<ImageLayer>& layers) {
+  const Format format = format_of(path);
+  if (!layers.empty() && format != Format::Exr) {
+    throw std::logic_error(path + ": only an OpenEXR image holds layers");
+  }
+  switch (format) {
     case Format::Png: return stage_png(path, width, height, rgb, encoding);
     case Format::Pfm: return stage_pfm(path, width, height, rgb);
-    case Format::Exr: return stage_exr(path, width, height, rgb, exr);
+    case Format::Exr: return stage_exr(path, width, height, rgb, exr, layers);
   }
   throw OutputError(path + ": unknown output format");  // not reached: format_of names every format
+}
+
+StagedFile stage_pfm_image(const std::string& path, int width, int height, const std::vector<float>& values,
+                           int channels) {
+  if (channels != 1 && channels != 3) throw std::logic_error(path + ": a PFM holds 1 or 3 channels");
+  return stage_pfm(path, width, height, values, channels);
 }
 
 StagedFile stage_file(const std::string& path, const std::string& text) {

@@ -48,11 +48,24 @@ class StagedFile {
   std::string path_, tmp_;  // tmp_ empty: nothing staged
 };
 
+// A further image written into an OpenEXR file beside the render's R, G and B (an
+// AOV): its channels are "<name>.<channel>", and `values` holds width * height *
+// channels.size() floats, row 0 = top.
+struct ImageLayer {
+  std::string name;
+  std::vector<std::string> channels;
+  const std::vector<float>* values;
+};
+
 // rgb: linear radiance, width * height * 3, row 0 = top. The encoding applies to PNG;
 // PFM and OpenEXR keep linear values, and `exr` is the pixel type of an OpenEXR image
-// (its alpha is 1). Throws OutputWriteError when the write fails.
+// (its alpha is 1), which also holds `layers` (only an OpenEXR image takes them).
+// Throws OutputWriteError when the write fails.
 StagedFile stage_image(const std::string& path, int width, int height, const std::vector<float>& rgb,
-                       Encoding encoding, ExrPixels exr = ExrPixels::Half);
+                       Encoding encoding, ExrPixels exr = ExrPixels::Half, const std::vector<ImageLayer>& layers = {});
+// A PFM of 1 (greyscale) or 3 channels: width * height * channels floats, row 0 = top.
+StagedFile stage_pfm_image(const std::string& path, int width, int height, const std::vector<float>& values,
+                           int channels);
 // Any bytes (a stats file's text, a checkpoint).
 StagedFile stage_file(const std::string& path, const std::string& bytes);
 

@@ -10,10 +10,19 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
 
 #include "../test_support.hpp"
 #include "image/denoise.hpp"
@@ -347,6 +356,106 @@ TEST_F(BatchCommand, DenoisingsBadInputIsOneLineAndNoFile) {
   }
   EXPECT_FALSE(fs::exists(path("o.png")));
   EXPECT_FALSE(fs::exists(path("o.noisy.png")));
+}
+
+// --aov: PFM files beside a PNG or PFM output, NAME.<aov>.pfm (the depth a
+// one-channel "Pf"), and layers of an OpenEXR output that OpenEXR reads back under
+// the names "<aov>.<channel>", holding the same values. Every kernel writes the same
+// files (the pass follows the camera's rays, not a kernel's); the stats list them.
+TEST_F(BatchCommand, AovsAreFilesBesideTheImageOrLayersOfItsExr) {
+  const std::string aovs = " --aov albedo,normal,depth,position";
+  const std::string common = "' --backend cpu --width 24 --height 16 --spp 4 -q --seed 5" + aovs;
+  ASSERT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("a.png") + common +
+                      " --kernel megakernel --stats '" + path("a.json") + "'"),
+            0)
+      << err_;
+  ASSERT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("b.pfm") + common + " --kernel wavefront"), 0)
+      << err_;
+  for (const char* name : {"albedo", "normal", "depth", "position"}) {
+    SCOPED_TRACE(name);
+    const std::string a = read(path(std::string("a.") + name + ".pfm")), b = read(path(std::string("b.") + name + ".pfm"));
+    EXPECT_FALSE(a.empty());
+    EXPECT_EQ(a, b) << "the megakernel's and the wavefront's AOVs differ";
+  }
+  EXPECT_EQ(read(path("a.depth.pfm")).rfind("Pf\n24 16\n-1.0\n", 0), 0u);
+  EXPECT_EQ(read(path("a.albedo.pfm")).rfind("PF\n24 16\n-1.0\n", 0), 0u);
+  const std::string stats = read(path("a.json"));
+  EXPECT_NE(stats.find("\"aovs\""), std::string::npos) << stats;
+  EXPECT_NE(stats.find("a.position.pfm"), std::string::npos) << stats;
+
+  ASSERT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("c.exr") + common + " --exr-float"), 0) << err_;
+  EXPECT_FALSE(fs::exists(path("c.albedo.pfm")));
+  Imf::InputFile file(path("c.exr").c_str());
+  std::vector<std::string> names;
+  for (auto c = file.header().channels().begin(); c != file.header().channels().end(); ++c) names.push_back(c.name());
+  EXPECT_EQ(names, (std::vector<std::string>{"A", "B", "G", "R", "albedo.B", "albedo.G", "albedo.R", "depth.Z",
+                                             "normal.X", "normal.Y", "normal.Z", "position.X", "position.Y",
+                                             "position.Z"}));
+  // The layers hold what the PFMs hold (the same render: the same seed).
+  const int w = 24, h = 16;
+  std::vector<float> albedo(w * h * 3), depth(w * h);
+  Imf::FrameBuffer frame;
+  const char* rgb[] = {"albedo.R", "albedo.G", "albedo.B"};
+  for (int c = 0; c < 3; ++c) {
+    frame.insert(rgb[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(albedo.data() + c), 3 * sizeof(float),
+                                    3 * sizeof(float) * w));
+  }
+  frame.insert("depth.Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data()), sizeof(float), sizeof(float) * w));
+  file.setFrameBuffer(frame);
+  file.readPixels(0, h - 1);
+  EXPECT_EQ(albedo, wt::test::read_pfm(path("a.albedo.pfm"), w, h));
+  // The depth PFM is one channel: read it as bytes after its header, bottom row first.
+  const std::string d = read(path("a.depth.pfm"));
+  const size_t header = std::string("Pf\n24 16\n-1.0\n").size();
+  ASSERT_EQ(d.size(), header + depth.size() * sizeof(float));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float v;
+      std::memcpy(&v, d.data() + header + (static_cast<size_t>(h - 1 - y) * w + x) * sizeof(float), sizeof v);
+      EXPECT_EQ(v, depth[y * w + x]) << x << ", " << y;
+    }
+  }
+  // The sphere fills the middle (about 3 units away), the corners see the sky.
+  EXPECT_NEAR(depth[(h / 2) * w + w / 2], 3.0f, 0.1f);
+  EXPECT_TRUE(std::isinf(depth[0]));
+
+  // A jobs file's key does the same.
+  std::ofstream(path("jobs.json")) << R"({"jobs": [{"scene": "s.json", "output": "j.png", "backend": "cpu",
+    "width": 16, "height": 8, "spp": 2, "aov": "normal"}]})";
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 0) << err_;
+  EXPECT_TRUE(fs::exists(path("j.normal.pfm")));
+}
+
+// An unknown AOV, or a file an AOV would be written to that cannot be (a folder, or
+// another of the job's files), is one line and exit 2 before anything renders; in a
+// jobs file, the line names the file and the field.
+TEST_F(BatchCommand, AovsBadInputIsOneLineAndNoFile) {
+  const std::string render = "render '" + path("s.json") + "' -o '" + path("o.png") + "' --backend cpu --width 8 --height 8 --spp 1 -q";
+  EXPECT_EQ(wavetrace(render + " --aov albedo,shadow"), 2) << err_;
+  EXPECT_NE(err_.find("--aov: unknown AOV 'shadow' (known: albedo, normal, depth, position)"), std::string::npos) << err_;
+  EXPECT_EQ(count(err_, "\n"), 1u) << err_;
+  fs::create_directories(path("o.albedo.pfm"));
+  EXPECT_EQ(wavetrace(render + " --aov albedo"), 2) << err_;
+  EXPECT_NE(err_.find("o.albedo.pfm"), std::string::npos) << err_;
+  EXPECT_EQ(count(err_, "\n"), 1u) << err_;
+  EXPECT_EQ(wavetrace(render + " --aov normal --checkpoint '" + path("o.normal.pfm") + "'"), 2) << err_;
+  EXPECT_NE(err_.find("normal AOV and checkpoint name the same file"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(path("o.png")));
+  EXPECT_FALSE(fs::exists(path("o.normal.pfm")));
+  std::ofstream(path("jobs.json")) << R"({"jobs": [{"scene": "s.json", "output": "j.png", "backend": "cpu",
+    "width": 8, "height": 8, "spp": 1, "aov": "depth,shadow"}]})";
+  EXPECT_NE(batch("'" + path("jobs.json") + "'"), 0) << err_;
+  EXPECT_NE(err_.find("/jobs/0/aov"), std::string::npos) << err_;
+  EXPECT_NE(err_.find("unknown AOV 'shadow'"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(path("j.png")));
+  // A job whose image is another's AOV: the batch refuses both before either renders.
+  std::ofstream(path("jobs2.json")) << R"({"jobs": [
+    {"scene": "s.json", "output": "k.png", "backend": "cpu", "width": 8, "height": 8, "spp": 1, "aov": "depth"},
+    {"scene": "s.json", "output": "k.depth.pfm", "backend": "cpu", "width": 8, "height": 8, "spp": 1}]})";
+  EXPECT_EQ(batch("'" + path("jobs2.json") + "'"), 2) << err_;
+  EXPECT_NE(err_.find("k.depth.pfm"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(path("k.png")));
+  EXPECT_FALSE(fs::exists(path("k.depth.pfm")));
 }
 
 }  // namespace

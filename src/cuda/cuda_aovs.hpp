@@ -1,0 +1,13 @@
+// The first-surface pass that the AOVs are made of (render/aovs.hpp), on the GPU.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include "wavetrace/scene_view.hpp"
+
+namespace wt::cuda {
+
+// Writes every pixel's kAovFloats sums over samples [0, rp.spp) to `sums`.
+void launch_first_surface(const SceneView& scene, const RenderParams& rp, float* sums, cudaStream_t stream);
+
+}  // namespace wt::cuda

@@ -1,0 +1,97 @@
+#include "render/aovs.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "errors/errors.hpp"
+#include "wavetrace/aov.hpp"
+
+namespace wt {
+
+const std::vector<std::string>& aov_names() {
+  static const std::vector<std::string> names = {"albedo", "normal", "depth", "position"};
+  return names;
+}
+
+const char* aov_name(AovKind kind) { return aov_names()[static_cast<size_t>(kind)].c_str(); }
+
+std::vector<AovKind> parse_aovs(const std::string& list, const std::string& field) {
+  std::vector<AovKind> kinds;
+  const std::string prefix = field.empty() ? "" : field + ": ";
+  size_t at = 0;
+  for (;;) {
+    const size_t comma = list.find(',', at);
+    std::string name = list.substr(at, comma == std::string::npos ? std::string::npos : comma - at);
+    name.erase(0, name.find_first_not_of(" \t"));
+    name.erase(name.find_last_not_of(" \t") + 1);
+    const auto& names = aov_names();
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) {
+      std::string known;
+      for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw InputError(prefix + "unknown AOV '" + name + "' (known: " + known + ")");
+    }
+    const AovKind kind = static_cast<AovKind>(it - names.begin());
+    if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) {
+      throw InputError(prefix + "AOV '" + name + "' is named twice");
+    }
+    kinds.push_back(kind);
+    if (comma == std::string::npos) break;
+    at = comma + 1;
+  }
+  return kinds;
+}
+
+namespace {
+
+// Channels [first, first + n) of each pixel's sums, divided by `over` (the samples,
+// or the pixel's hits); `missing` where that is 0.
+std::vector<float> means(const std::vector<float>& sums, int first, int n, int32_t samples, bool over_hits,
+                         float missing, float lo = -std::numeric_limits<float>::infinity(),
+                         float hi = std::numeric_limits<float>::infinity()) {
+  const size_t pixels = sums.size() / kAovFloats;
+  std::vector<float> out(pixels * n);
+  for (size_t p = 0; p < pixels; ++p) {
+    const float* s = sums.data() + p * kAovFloats;
+    const float count = over_hits ? s[kAovHits] : static_cast<float>(samples);
+    for (int c = 0; c < n; ++c) {
+      out[p * n + c] = count > 0.0f ? std::clamp(s[first + c] / count, lo, hi) : missing;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples) {
+  AovImage image{kind, aov_name(kind), {}, {}};
+  switch (kind) {
+    case AovKind::Albedo:
+      image.channels = {"R", "G", "B"};
+      image.values = means(sums, kAovAlbedo, 3, samples, false, 0.0f);
+      break;
+    case AovKind::Normal:
+      image.channels = {"X", "Y", "Z"};
+      image.values = means(sums, kAovNormal, 3, samples, false, 0.0f);
+      break;
+    case AovKind::Depth:
+      image.channels = {"Z"};
+      image.values = means(sums, kAovDepth, 1, samples, true, std::numeric_limits<float>::infinity());
+      break;
+    case AovKind::Position:
+      image.channels = {"X", "Y", "Z"};
+      image.values = means(sums, kAovPosition, 3, samples, true, 0.0f);
+      break;
+  }
+  return image;
+}
+
+std::vector<float> denoise_albedo(const std::vector<float>& sums, int32_t samples) {
+  return means(sums, kAovAlbedo, 3, samples, false, 0.0f, 0.0f, 1.0f);
+}
+
+std::vector<float> denoise_normal(const std::vector<float>& sums, int32_t samples) {
+  return means(sums, kAovNormal, 3, samples, false, 0.0f, -1.0f, 1.0f);
+}
+
+}  // namespace wt

@@ -1,0 +1,50 @@
+// The AOVs a render can write beside its image (--aov), from the sums of the
+// first-surface pass (include/wavetrace/aov.hpp) that every backend runs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace wt {
+
+enum class AovKind : uint32_t { Albedo, Normal, Depth, Position };
+
+// The AOVs' names, as --aov takes them: "albedo", "normal", "depth", "position".
+const std::vector<std::string>& aov_names();
+const char* aov_name(AovKind kind);
+
+// A comma-separated list of names ("albedo,normal"), each at most once, in the order
+// given. Throws InputError naming `field` (where not empty) and the name for an
+// unknown or repeated one.
+std::vector<AovKind> parse_aovs(const std::string& list, const std::string& field = "--aov");
+
+// The first-surface pass's sums (kAovFloats floats a pixel, include/wavetrace/aov.hpp)
+// over samples [0, samples) of every pixel, as a backend returns them.
+struct AovSums {
+  std::vector<float> sums;
+  int32_t samples = 0;
+  double seconds = 0;  // the pass alone (CUDA events on the GPU, wall clock on the CPU)
+};
+
+// One AOV as an image: its name, its channels' names ("R", "G", "B"; "X", "Y", "Z";
+// "Z" for depth) and width x height x channels floats, row 0 = top.
+struct AovImage {
+  AovKind kind;
+  std::string name;
+  std::vector<std::string> channels;
+  std::vector<float> values;
+};
+
+// The AOV `kind` of a render from the first-surface pass's sums over `samples`
+// samples a pixel (kAovFloats a pixel): albedo and normal are means over every
+// sample; depth and position means over the samples that hit a surface, a pixel none
+// of whose samples did holding an infinite depth and a zero position.
+AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples);
+
+// The albedo and normal as OIDN takes them: the albedo's mean clamped to [0, 1], the
+// normal's mean.
+std::vector<float> denoise_albedo(const std::vector<float>& sums, int32_t samples);
+std::vector<float> denoise_normal(const std::vector<float>& sums, int32_t samples);
+
+}  // namespace wt
