@@ -35,7 +35,7 @@ auto fields(const Job& j) {
   return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
                   j.kernel, j.warmup, j.wave_size, j.threads, j.devices, j.checkpoint, j.resume, j.checkpoint_every,
                   j.encoding, j.exr_float, j.progress, j.profile, j.denoise, j.denoise_quality, j.keep_noisy,
-                  j.aov);
+                  j.aov, j.megakernel_batch);
 }
 
 
@@ -67,6 +67,7 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   every.denoise_quality = "balanced";
   every.keep_noisy = true;
   every.aov = "position,albedo";
+  every.megakernel_batch = 7;
   Job defaults;
   defaults.scene = "s.json";
   defaults.output = "o.png";

@@ -265,6 +265,42 @@ TEST(KernelAgreement, CudaKernelsMatchCudaMegakernel) {
   }
 }
 
+// A small image's megakernel runs batches of samples, one thread a pixel and sample,
+// and folds them into the film in sample order: the image is the one-thread-a-pixel
+// launch's bit for bit, however the samples fall into batches (one pass of 24
+// samples; batches of 5 leave a short one), with the same rays counted. Both
+// megakernels, on the materials scene (every BSDF, textures, lights).
+TEST(KernelAgreement, CudaMegakernelBatchesChangeNoBit) {
+  WT_REQUIRE_CUDA();
+  const Scene scene = load_scene(test::repo_path("scenes/cornell-materials.json"));
+  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant}) {
+    SCOPED_TRACE(kernel_name(k));
+    RenderOptions o = options_for(Backend::Cuda, k, 48, 32, 24, 8, 3, 9);
+    o.samples_per_pass = 24;
+    o.megakernel_batch = 1;
+    const RenderResult one = render(scene, o);
+    for (int batch : {5, 24, 0}) {
+      o.megakernel_batch = batch;
+      const RenderResult batched = render(scene, o);
+      ASSERT_EQ(batched.rgb.size(), one.rgb.size());
+      size_t differ = 0;
+      for (size_t i = 0; i < one.rgb.size(); ++i) differ += batched.rgb[i] != one.rgb[i];
+      EXPECT_EQ(differ, 0u) << "batch " << batch;
+      EXPECT_EQ(batched.rays, one.rays) << "batch " << batch;
+      EXPECT_EQ(batched.shadow_rays, one.shadow_rays) << "batch " << batch;
+    }
+  }
+}
+
+// The batch a megakernel launch takes: about four full waves of threads of the device
+// (132 SMs: an H100), within the pass's samples; one thread a pixel at 1080p.
+TEST(KernelAgreement, TheMegakernelsBatchFillsTheDevice) {
+  EXPECT_EQ(cuda::megakernel_batch(1920 * 1080, 132, 100), 1);
+  EXPECT_EQ(cuda::megakernel_batch(512 * 384, 132, 100), 6);
+  EXPECT_EQ(cuda::megakernel_batch(256 * 256, 132, 100), 17);
+  EXPECT_EQ(cuda::megakernel_batch(256 * 256, 132, 4), 4);
+}
+
 TEST(BackendAgreement, CudaMatchesCpuForEachKernel) {
   WT_REQUIRE_CUDA();
   for (Kernel k : {Kernel::Megakernel, Kernel::Wavefront}) {

@@ -238,6 +238,7 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.warmup = static_cast<int>(job.warmup);
   options.shade_by_kind = job.profile;
   options.wave_size = job.wave_size;
+  options.megakernel_batch = static_cast<int32_t>(job.megakernel_batch);
   options.threads = static_cast<int>(job.threads);
   options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
   return options;

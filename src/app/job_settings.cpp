@@ -34,6 +34,8 @@ void set_setting(Job& job, SettingId id, int64_t value) {
     job.threads = value;
   } else if (id == SettingId::CheckpointEvery) {
     job.checkpoint_every = value;
+  } else if (id == SettingId::MegakernelBatch) {
+    job.megakernel_batch = value;
   }
 }
 
@@ -46,6 +48,7 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
     case SettingId::WaveSize: return unless_default(job.wave_size, defaults.wave_size);
     case SettingId::Threads: return unless_default(job.threads, defaults.threads);
     case SettingId::CheckpointEvery: return unless_default(job.checkpoint_every, defaults.checkpoint_every);
+    case SettingId::MegakernelBatch: return unless_default(job.megakernel_batch, defaults.megakernel_batch);
     default: return std::nullopt;
   }
 }

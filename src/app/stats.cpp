@@ -110,6 +110,7 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["settings"] = settings_json(o.params);
   j["settings"][setting(SettingId::Warmup).key] = job.warmup;
   j["settings"][setting(SettingId::WaveSize).key] = job.wave_size;
+  j["settings"][setting(SettingId::MegakernelBatch).key] = job.megakernel_batch;
   j["backend"] = o.backend;
   j["kernel"] = o.kernel;
   j["device"] = r.device;

@@ -28,7 +28,8 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 // The megakernel renders in passes of samples (at least ten, so that progress can
 // be shown between them); the next pass is queued before the host waits on the
 // last one, unless after_pass must see each pass's film.
-RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options) {
+RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options,
+                               int sm_count) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
   if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
@@ -38,6 +39,22 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   float* const film = options.device_film ? options.device_film : own_film.get();
   DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
+  // A small image's passes run in batches of samples (megakernel_batch), each
+  // sample's radiance stored, then folded into running sums in sample order.
+  int largest_pass = 0;
+  for (const SamplePass& pass : passes) largest_pass = std::max(largest_pass, pass.count);
+  const int batch = options.megakernel_batch > 0
+                        ? std::min(options.megakernel_batch, std::max(largest_pass, 1))
+                        : megakernel_batch(static_cast<int64_t>(pixels), sm_count, largest_pass);
+  DeviceBuffer<float> radiance(batch > 1 ? pixels * 3 * batch : 0, kStage);
+  DeviceBuffer<float> running(batch > 1 ? pixels * 3 : 0, kStage);
+  auto launch = [&](int first, int count, MegakernelOut out) {
+    if (constant) {
+      launch_megakernel_constant(rp, first, count, out, rays.get(), nullptr);
+    } else {
+      launch_megakernel(ds.view(), rp, first, count, out, rays.get(), nullptr);
+    }
+  };
 
   RenderResult out;
   auto run = [&](bool last) {
@@ -55,10 +72,14 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     std::vector<Event> pass_done(passes.size());
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
-      if (constant) {
-        launch_megakernel_constant(rp, pass.first, pass.count, film, rays.get(), nullptr);
+      if (batch <= 1) {
+        launch(pass.first, pass.count, MegakernelOut{film, nullptr});
       } else {
-        launch_megakernel(ds.view(), rp, pass.first, pass.count, film, rays.get(), nullptr);
+        for (int at = 0; at < pass.count; at += batch) {
+          const int n = std::min(batch, pass.count - at);
+          launch(pass.first + at, n, MegakernelOut{nullptr, radiance.get()});
+          launch_megakernel_fold(rp, n, radiance.get(), running.get(), film, at == 0, at + n == pass.count, nullptr);
+        }
       }
       pass_done[p].record("megakernel");
       out.samples = pass.first + pass.count;
@@ -93,11 +114,15 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
 }  // namespace
 
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size) {
-  size_t film = static_cast<size_t>(rp.width) * rp.height * 3 * sizeof(float);
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  const size_t film = pixels * 3 * sizeof(float);
   if (is_wavefront(kernel)) {
     return film + wavefront_bytes(wave_size);
   }
-  return film;
+  // A small image's batches: each sample's radiance and the running sums, as large as
+  // on a device of 256 SMs.
+  const int batch = megakernel_batch(static_cast<int64_t>(pixels), 256, rp.spp);
+  return film + (batch > 1 ? film * (batch + 1) : 0);
 }
 
 void require_device_memory(const RenderParams& rp, size_t need, size_t free_bytes, const std::string& device) {
@@ -159,7 +184,7 @@ class Uploaded {
   RenderResult render(const RenderOptions& options) const {
     RenderResult out = is_wavefront(options.kernel)
                            ? waves_.render(ds_->view(), scene_.sort_key_bits(), options, wave_)
-                           : render_megakernel(scene_, *ds_, options);
+                           : render_megakernel(scene_, *ds_, options, info_.sm_count);
     out.upload_seconds = upload_;
     out.device = info_.name;
     return out;

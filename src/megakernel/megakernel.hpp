@@ -4,16 +4,41 @@
 
 #include <cuda_runtime.h>
 
+#include <cstdint>
 #include <vector>
 
 #include "scene/scene.hpp"
 
 namespace wt::cuda {
 
-// Adds samples [first_sample, first_sample + samples) of every pixel to film (RGB
-// sums), the path rays they intersect to rays[0] and the shadow rays to rays[1].
-void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples, float* film,
-                       unsigned long long* rays, cudaStream_t stream);
+// Where a launch puts its samples (megakernel_body.cuh): added to `film`, one thread
+// a pixel looping over them (radiance null); or, for a batch of a small image's
+// samples, one thread a pixel and sample, each sample's radiance stored in
+// `radiance` for launch_megakernel_fold.
+struct MegakernelOut {
+  float* film;
+  float* radiance;
+};
+
+// A small image fills the GPU with too few threads at one a pixel (at 512 x 384 an
+// H200 runs 2.3 waves of the megakernel, the last a third full), so its passes run
+// in batches of this many samples, one thread a pixel and sample: enough threads for
+// about four full waves of the device (sm_count x 2048 x 4), at most the pass's
+// samples (and 1024). 1: one thread a pixel (1920 x 1080 on 132 SMs, and larger).
+int megakernel_batch(int64_t pixels, int sm_count, int pass_samples);
+
+// Adds samples [first_sample, first_sample + samples) of every pixel to out.film (RGB
+// sums), or stores each in out.radiance (samples x pixels x 3 floats), and the path
+// rays they intersect to rays[0] and the shadow rays to rays[1].
+void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples,
+                       MegakernelOut out, unsigned long long* rays, cudaStream_t stream);
+
+// Adds a batch's stored samples (`samples` of them, in sample order) to each pixel's
+// running sum (from zero where `first`), and where `last` (the pass's last batch) the
+// sum to the film: the additions of the one-thread-a-pixel loop, in its order, so
+// that batches change no bit of the image.
+void launch_megakernel_fold(const RenderParams& rp, int samples, const float* radiance, float* running, float* film,
+                            bool first, bool last, cudaStream_t stream);
 
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();
@@ -22,7 +47,7 @@ size_t constant_scene_capacity();
 // `images` are the device image views (texture objects) of the uploaded scene.
 void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images);
 
-void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, float* film,
+void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelOut out,
                                 unsigned long long* rays, cudaStream_t stream);
 
 }  // namespace wt::cuda

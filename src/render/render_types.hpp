@@ -122,6 +122,10 @@ struct RenderOptions {
   // a stage each ("shade <kind>", added to the result's stages after the others;
   // --profile). The image is the same; the shade stage's own time is then theirs.
   bool shade_by_kind = false;
+  // The CUDA megakernels' samples a thread-per-sample launch takes at once
+  // (megakernel_batch): 0 chooses by the image's size and the device's; 1 is one
+  // thread a pixel; tests set others. The image is the same bit for bit.
+  int32_t megakernel_batch = 0;
 };
 
 // What one device did in a render split over several (dispatch/split.hpp).

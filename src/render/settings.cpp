@@ -24,6 +24,9 @@ const std::vector<Setting>& settings() {
       {SettingId::Threads, "threads", "--threads", SettingType::Int32, 1, 1024, 0, "CPU threads (default: all cores)"},
       {SettingId::CheckpointEvery, "checkpoint_every", "--checkpoint-every", SettingType::Int32, 1, 30 * 24 * 3600,
        300, "seconds between checkpoints (with --checkpoint)"},
+      {SettingId::MegakernelBatch, "megakernel_batch", "--megakernel-batch", SettingType::Int32, 0, 1024, 0,
+       "CUDA megakernels: samples a launch of one thread a pixel and sample takes (default 0: chosen by the "
+       "image's size and the device's; 1: one thread a pixel); the image is the same"},
   };
   return table;
 }

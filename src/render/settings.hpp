@@ -29,7 +29,20 @@ struct RenderDefaults : RenderParams {
   RenderDefaults() : RenderParams{640, 360, 16, 10, 5, 1} {}
 };
 
-enum class SettingId { Width, Height, Spp, Depth, RouletteDepth, Seed, Nee, Warmup, WaveSize, Threads, CheckpointEvery };
+enum class SettingId {
+  Width,
+  Height,
+  Spp,
+  Depth,
+  RouletteDepth,
+  Seed,
+  Nee,
+  Warmup,
+  WaveSize,
+  Threads,
+  CheckpointEvery,
+  MegakernelBatch
+};
 
 enum class SettingType { Int32, UInt32, Int64 };
 
