@@ -156,9 +156,9 @@ TEST(Aovs, TheListNamesKnownAovsOnce) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(message("albedo,shadow"), "--aov: unknown AOV 'shadow' (known: albedo, normal, depth, position)");
+  EXPECT_EQ(message("albedo,shadow"), "--aov: unknown AOV 'shadow' (known: albedo, normal, depth, position, variance, spp)");
   EXPECT_EQ(message("normal,normal"), "--aov: AOV 'normal' is named twice");
-  EXPECT_EQ(message("albedo,"), "--aov: unknown AOV '' (known: albedo, normal, depth, position)");
+  EXPECT_EQ(message("albedo,"), "--aov: unknown AOV '' (known: albedo, normal, depth, position, variance, spp)");
 }
 
 }  // namespace

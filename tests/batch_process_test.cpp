@@ -35,7 +35,7 @@ auto fields(const Job& j) {
   return std::tie(j.scene, j.output, j.stats, j.width, j.height, j.spp, j.depth, j.roulette_depth, j.seed, j.backend,
                   j.kernel, j.warmup, j.wave_size, j.threads, j.devices, j.checkpoint, j.resume, j.checkpoint_every,
                   j.encoding, j.exr_float, j.progress, j.profile, j.denoise, j.denoise_quality, j.keep_noisy,
-                  j.aov, j.megakernel_batch);
+                  j.aov, j.megakernel_batch, j.noise_threshold, j.min_spp);
 }
 
 
@@ -68,6 +68,8 @@ TEST(BatchProcess, AJobBecomesRenderArgumentsThatParseBackIntoTheSameJob) {
   every.keep_noisy = true;
   every.aov = "position,albedo";
   every.megakernel_batch = 7;
+  every.noise_threshold = 0.0123456789012345;
+  every.min_spp = 12;
   Job defaults;
   defaults.scene = "s.json";
   defaults.output = "o.png";

@@ -1,5 +1,7 @@
 #include "app/cli.hpp"
 
+#include <cstdio>
+
 #include "errors/errors.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
@@ -30,6 +32,9 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
   cmd.add_option("--denoise-quality", job.denoise_quality, "the denoiser's quality: high (default) or balanced")
       ->check(CLI::IsMember(denoise_quality_choices()));
   cmd.add_flag("--keep-noisy", job.keep_noisy, "with --denoise: write the render itself too, as NAME.noisy.EXT");
+  cmd.add_option("--noise-threshold", job.noise_threshold,
+                 "adaptive sampling: each pixel stops once its neighbourhood's relative error is at most this "
+                 "(e.g. 0.01), after --min-spp samples and at most --spp");
   cmd.add_option("--aov", job.aov,
                  "write these AOVs too, comma-separated: " + listed(aov_names()) +
                      " (layers of an .exr output, else NAME.<aov>.pfm beside it)");
@@ -85,6 +90,11 @@ std::vector<std::string> render_arguments(const Job& job) {
   }
   if (job.keep_noisy) args.push_back("--keep-noisy");
   add("--aov", job.aov);
+  if (job.noise_threshold) {
+    char t[40];
+    std::snprintf(t, sizeof t, "%.17g", *job.noise_threshold);
+    add("--noise-threshold", t);
+  }
   if (!job.progress) args.push_back("--quiet");
   if (job.profile) args.push_back("--profile");
   args.push_back("--");  // the scene, whatever its name

@@ -207,6 +207,25 @@ class ContextStart {
 // nothing, and no output may overwrite another. Of an MPI run, rank 0 alone writes
 // (and keeps no checkpoint).
 void check_outputs(const Job& job, bool distributed) {
+  if (job.noise_threshold && !(*job.noise_threshold > 0)) {
+    char got[32];
+    std::snprintf(got, sizeof got, "%g", *job.noise_threshold);
+    throw InputError(std::string("--noise-threshold: must be above 0 (got ") + got + ")");
+  }
+  bool variance = false;
+  if (!job.aov.empty()) {
+    for (AovKind k : parse_aovs(job.aov)) variance = variance || k == AovKind::Variance;
+  }
+  if (job.noise_threshold || variance) {
+    const char* what = job.noise_threshold ? "--noise-threshold" : "--aov variance";
+    if (!checkpoint_of(job).empty()) {
+      throw InputError(std::string(what) + ": an adaptive render keeps no checkpoint yet; render it without --checkpoint/--resume");
+    }
+    if (distributed) throw InputError(std::string(what) + ": an adaptive render runs in one process, not over MPI ranks yet");
+  }
+  if (job.min_spp > 0 && !job.noise_threshold) {
+    throw InputError("--min-spp: the samples every pixel takes before adaptive sampling stops any; give --noise-threshold too");
+  }
   if (job.keep_noisy && !job.denoise) throw InputError("--keep-noisy: keeps the render beside a denoised image: give --denoise too");
   if (job.denoise) {
     std::string why;
@@ -239,6 +258,15 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.shade_by_kind = job.profile;
   options.wave_size = job.wave_size;
   options.megakernel_batch = static_cast<int32_t>(job.megakernel_batch);
+  options.noise_threshold = job.noise_threshold.value_or(0.0);
+  options.min_spp = static_cast<int32_t>(job.min_spp);
+  // The variance AOV is the adaptive rounds' estimate: without a threshold, the same
+  // rounds with no pixel stopping.
+  if (options.noise_threshold == 0 && !job.aov.empty()) {
+    for (AovKind k : parse_aovs(job.aov)) {
+      if (k == AovKind::Variance) options.noise_threshold = -1;
+    }
+  }
   options.threads = static_cast<int>(job.threads);
   options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
   return options;
@@ -417,7 +445,10 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   // The AOVs: layers of an OpenEXR output, else files of their own beside it.
   std::vector<AovImage> aovs;
   if (!job.aov.empty()) {
-    for (AovKind k : parse_aovs(job.aov)) aovs.push_back(aov_image(k, out.aovs.sums, out.aovs.samples));
+    for (AovKind k : parse_aovs(job.aov)) {
+      aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs.sums, out.aovs.samples)
+                                           : result_aov_image(k, out.result));
+    }
   }
   const std::vector<JobFile> aov_files = aov_outputs(job);
   std::vector<ImageLayer> layers;
@@ -488,7 +519,11 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     if (distributed) take_mean(out.result);
     // The AOVs and the denoiser's guides: one first-surface pass over the whole
     // render's samples, whatever kernel, checkpoint or ranks made the image.
-    if (!job.aov.empty() || job.denoise) out.aovs = render_aovs(*scene, options);
+    bool first_surface = job.denoise;
+    if (!job.aov.empty()) {
+      for (AovKind k : parse_aovs(job.aov)) first_surface = first_surface || from_first_surface(k);
+    }
+    if (first_surface) out.aovs = render_aovs(*scene, options);
     write_job(job, options, out, job_start);
   });
   return out;

@@ -26,6 +26,9 @@ struct Job {
   int64_t wave_size = 0;  // 0: chosen at run time
   int64_t threads = 0;    // 0: every core
   int64_t megakernel_batch = 0;  // 0: chosen at run time (RenderOptions::megakernel_batch)
+  // Adaptive sampling (render/adaptive.hpp): unset off, else above 0; min_spp 0 chooses.
+  std::optional<double> noise_threshold;
+  int64_t min_spp = 0;
   // The devices to split the render over: "all" (every CUDA device; on the CPU
   // backend, one), or indices "0,1" (on the CPU backend, as many host "devices").
   std::string devices = "all";

@@ -36,6 +36,8 @@ void set_setting(Job& job, SettingId id, int64_t value) {
     job.checkpoint_every = value;
   } else if (id == SettingId::MegakernelBatch) {
     job.megakernel_batch = value;
+  } else if (id == SettingId::MinSpp) {
+    job.min_spp = value;
   }
 }
 
@@ -49,6 +51,7 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
     case SettingId::Threads: return unless_default(job.threads, defaults.threads);
     case SettingId::CheckpointEvery: return unless_default(job.checkpoint_every, defaults.checkpoint_every);
     case SettingId::MegakernelBatch: return unless_default(job.megakernel_batch, defaults.megakernel_batch);
+    case SettingId::MinSpp: return unless_default(job.min_spp, defaults.min_spp);
     default: return std::nullopt;
   }
 }

@@ -111,6 +111,18 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["settings"][setting(SettingId::Warmup).key] = job.warmup;
   j["settings"][setting(SettingId::WaveSize).key] = job.wave_size;
   j["settings"][setting(SettingId::MegakernelBatch).key] = job.megakernel_batch;
+  j["settings"][setting(SettingId::MinSpp).key] = job.min_spp;
+  if (job.noise_threshold) {
+    // Adaptive sampling: its threshold, and how it ended.
+    const RenderResult& a = o.result;
+    uint64_t samples = 0;
+    for (int32_t n : a.pixel_samples) samples += static_cast<uint64_t>(n);
+    j["adaptive"] = {{"noise_threshold", *job.noise_threshold},
+                     {"converged_pixels", a.converged},
+                     {"pixels", a.pixel_samples.size()},
+                     {"mean_spp", a.pixel_samples.empty() ? 0.0 : static_cast<double>(samples) / a.pixel_samples.size()},
+                     {"max_spp", a.samples}};
+  }
   j["backend"] = o.backend;
   j["kernel"] = o.kernel;
   j["device"] = r.device;

@@ -40,14 +40,18 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
   const int threads = thread_count(options.threads);
   auto t0 = Clock::now();
   auto last_report = t0;
-  const int64_t all_pixels = pixels * static_cast<int64_t>(passes.size());
+  // The pixels a sample visits: those listed, or every one.
+  const std::vector<uint32_t>* active = options.active_pixels;
+  const int64_t rendered = static_cast<int64_t>(rendered_pixels(options));
+  const int64_t all_pixels = rendered * static_cast<int64_t>(passes.size());
   for (size_t p = 0; p < passes.size(); ++p) {
     const SamplePass& pass = passes[p];
     // One row per chunk: whole rows keep the progress steady and the cache warm.
-    parallel_for(pixels, rp.width, threads, [&](int64_t begin, int64_t end, int tid) {
+    parallel_for(rendered, rp.width, threads, [&](int64_t begin, int64_t end, int tid) {
       uint32_t path_rays = 0, path_shadow_rays = 0;
       uint64_t local_rays = 0, local_shadow_rays = 0;
-      for (int64_t px = begin; px < end; ++px) {
+      for (int64_t i = begin; i < end; ++i) {
+        const int64_t px = active ? (*active)[i] : i;
         vec3 sum(0.0f);
         for (int32_t s = pass.first; s < pass.first + pass.count; ++s) {
           path_rays = 0;
@@ -72,7 +76,7 @@ RenderResult render_megakernel(const SceneView& view, const RenderParams& rp, co
       }
     });
     out.samples = pass.first + pass.count;
-    out.paths += static_cast<uint64_t>(pixels) * pass.count;
+    out.paths += static_cast<uint64_t>(rendered) * pass.count;
     if (last && options.after_pass && !options.after_pass(out.samples, [&] { return out.rgb; })) {
       out.interrupted = p + 1 < passes.size();
       break;

@@ -87,7 +87,10 @@ class Executor {
   }
 
   void zero(void* p, size_t bytes) { std::memset(p, 0, bytes); }
-  void upload(float* p, const std::vector<float>& v) { std::copy(v.begin(), v.end(), p); }
+  template <class T>
+  void upload(T* p, const std::vector<T>& v) {
+    std::copy(v.begin(), v.end(), p);
+  }
   std::vector<float> download(const float* p, size_t n) { return std::vector<float>(p, p + n); }
 
   void start_timer() { start_ = Clock::now(); }

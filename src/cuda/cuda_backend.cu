@@ -33,9 +33,13 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
   if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
-  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  // The pixels a sample visits: options.active_pixels, on the device, or every one.
+  const size_t pixels = rendered_pixels(options);
+  DeviceBuffer<uint32_t> active(options.active_pixels ? pixels : 0, kStage);
+  if (options.active_pixels && pixels > 0) active.upload(*options.active_pixels, kStage);
+  const size_t film_floats = static_cast<size_t>(rp.width) * rp.height * 3;
   // The render's own film, or the one it adds into (options.device_film).
-  DeviceBuffer<float> own_film(options.device_film ? 0 : pixels * 3, kStage);
+  DeviceBuffer<float> own_film(options.device_film ? 0 : film_floats, kStage);
   float* const film = options.device_film ? options.device_film : own_film.get();
   DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
@@ -48,7 +52,17 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
                         : megakernel_batch(static_cast<int64_t>(pixels), sm_count, largest_pass);
   DeviceBuffer<float> radiance(batch > 1 ? pixels * 3 * batch : 0, kStage);
   DeviceBuffer<float> running(batch > 1 ? pixels * 3 : 0, kStage);
-  auto launch = [&](int first, int count, MegakernelOut out) {
+  // The work of a launch over the render's pixels: samples into `to_film`, or stored
+  // in `to_radiance`.
+  auto work = [&](float* to_film, float* to_radiance) {
+    MegakernelWork w{to_film, to_radiance};
+    if (options.active_pixels) {
+      w.active = active.get();
+      w.count = static_cast<uint32_t>(pixels);
+    }
+    return w;
+  };
+  auto launch = [&](int first, int count, const MegakernelWork& out) {
     if (constant) {
       launch_megakernel_constant(rp, first, count, out, rays.get(), nullptr);
     } else {
@@ -73,12 +87,13 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
       if (batch <= 1) {
-        launch(pass.first, pass.count, MegakernelOut{film, nullptr});
+        launch(pass.first, pass.count, work(film, nullptr));
       } else {
         for (int at = 0; at < pass.count; at += batch) {
           const int n = std::min(batch, pass.count - at);
-          launch(pass.first + at, n, MegakernelOut{nullptr, radiance.get()});
-          launch_megakernel_fold(rp, n, radiance.get(), running.get(), film, at == 0, at + n == pass.count, nullptr);
+          launch(pass.first + at, n, work(nullptr, radiance.get()));
+          launch_megakernel_fold(rp, n, work(film, radiance.get()), running.get(), at == 0, at + n == pass.count,
+                                 nullptr);
         }
       }
       pass_done[p].record("megakernel");

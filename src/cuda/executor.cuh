@@ -170,8 +170,9 @@ class Executor {
 
   void zero(void* p, size_t bytes) { WT_CUDA(cudaMemsetAsync(p, 0, bytes, stream_), "wavefront"); }
 
-  void upload(float* p, const std::vector<float>& v) {
-    WT_CUDA(cudaMemcpyAsync(p, v.data(), v.size() * sizeof(float), cudaMemcpyHostToDevice, stream_), "wavefront");
+  template <class T>
+  void upload(T* p, const std::vector<T>& v) {
+    WT_CUDA(cudaMemcpyAsync(p, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice, stream_), "wavefront");
   }
 
   std::vector<float> download(const float* p, size_t n) {

@@ -1,10 +1,12 @@
 #include "dispatch/renderer.hpp"
 
+#include <algorithm>
 #include <string>
 
 #include "cpu/cpu_backend.hpp"
 #include "cuda/cuda_backend.hpp"
 #include "dispatch/split.hpp"
+#include "render/adaptive.hpp"
 #include "errors/errors.hpp"
 #include "render/settings.hpp"
 
@@ -16,11 +18,15 @@ namespace {
 
 // On one device, the backend's own render; on several (options.devices), the split
 // over the backend's renderer of each, labelled "cuda:1", "cpu:0", ...
-RenderResult render_on_backend(const Scene& scene, const RenderOptions& options) {
+void check_kernel_runs(const RenderOptions& options) {
   if (!kernel_runs_on(options.kernel, options.backend)) {
     throw InputError(std::string("kernel: ") + kernel_name(options.kernel) +
                      " needs the cuda backend (constant memory is a GPU memory)");
   }
+}
+
+RenderResult render_on_backend(const Scene& scene, const RenderOptions& options) {
+  check_kernel_runs(options);
   const bool gpu = options.backend == Backend::Cuda;
   if (gpu) cuda::check_devices(options);
   if (options.devices.size() <= 1) return gpu ? cuda::render(scene, options) : cpu::render(scene, options);
@@ -40,13 +46,45 @@ void validate_params(const RenderParams& p) {
 
 RenderParams default_params(const Scene& scene) { return scene.render; }
 
+namespace {
+
+// Adaptive sampling on the first of the options' devices: its renderer made once
+// (the scene uploaded once), then called for each round of samples.
+RenderResult render_adaptively(const Scene& scene, const RenderOptions& options) {
+  if (options.initial_film || options.after_pass || options.path_feed || options.device_film) {
+    throw InputError("--noise-threshold: not with checkpoints, a resumed render or MPI ranks yet");
+  }
+  if (options.min_spp > options.params.spp) {
+    throw InputError("--min-spp: " + std::to_string(options.min_spp) + " is more than the " +
+                     std::to_string(options.params.spp) + " samples per pixel (--spp, the most a pixel takes)");
+  }
+  check_kernel_runs(options);
+  const bool gpu = options.backend == Backend::Cuda;
+  if (gpu) cuda::check_devices(options);
+  RenderOptions one = options;
+  one.devices = {options.devices.empty() ? 0 : options.devices.front()};
+  const DeviceRenderer device = gpu ? cuda::device_renderer(scene, one, 0) : cpu::device_renderer(scene, one, 0);
+  const int32_t min_spp = options.min_spp > 0 ? options.min_spp : std::min(16, options.params.spp);
+  const double threshold = options.noise_threshold > 0 ? options.noise_threshold : -1.0;
+  one.devices.clear();
+  RenderResult r = render_adaptive(device.render, one, threshold, min_spp);
+  if (options.progress) options.progress(1.0, r.rays, r.seconds);
+  return r;
+}
+
+}  // namespace
+
 RenderResult render(const Scene& scene, const RenderOptions& options) {
+  if (options.noise_threshold != 0) {
+    validate_render(options);
+    return render_adaptively(scene, options);
+  }
   RenderResult r = render_sums(scene, options);
   take_mean(r);
   return r;
 }
 
-RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
+void validate_render(const RenderOptions& options) {
   const RenderParams& p = options.params;
   validate_params(p);
   if (options.wave_size != 0) check_setting(SettingId::WaveSize, options.wave_size);
@@ -62,6 +100,10 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
                      " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
                      std::to_string(film_floats));
   }
+}
+
+RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
+  validate_render(options);
   return render_on_backend(scene, options);
 }
 

@@ -13,7 +13,9 @@ const char* backend_name(Backend b);
 
 // Fails with InputError for settings the backend cannot honour (naming the setting),
 // and DeviceError (cuda::CudaError for CUDA calls, naming the call and the stage)
-// when the machine fails. The result holds each pixel's mean radiance.
+// when the machine fails. The result holds each pixel's mean radiance. With
+// options.noise_threshold, the render is adaptive (render/adaptive.hpp), on the first
+// of the options' devices.
 RenderResult render(const Scene& scene, const RenderOptions& options);
 // The same render, its result the pixels' sums over the samples it rendered
 // (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
@@ -31,6 +33,8 @@ void take_mean(RenderResult& r);
 
 // Checks RenderParams against the sane limits; throws InputError naming the setting.
 void validate_params(const RenderParams& p);
+// Those and the rest of the options (the samples, the initial film).
+void validate_render(const RenderOptions& options);
 
 // Params from the scene's defaults.
 RenderParams default_params(const Scene& scene);

@@ -11,13 +11,17 @@
 
 namespace wt::cuda {
 
-// Where a launch puts its samples (megakernel_body.cuh): added to `film`, one thread
-// a pixel looping over them (radiance null); or, for a batch of a small image's
-// samples, one thread a pixel and sample, each sample's radiance stored in
-// `radiance` for launch_megakernel_fold.
-struct MegakernelOut {
+// A launch's pixels and where it puts their samples (megakernel_body.cuh): the
+// `count` pixels `active` lists (adaptive sampling's pixels still going), or every
+// pixel (active null); their samples added to `film`, one thread a pixel looping
+// over them (radiance null), or, for a batch of a small image's samples, one thread
+// a pixel and sample, each sample's radiance stored in `radiance` (samples x count x
+// 3 floats, by the pixel's place in the list) for launch_megakernel_fold.
+struct MegakernelWork {
   float* film;
   float* radiance;
+  const uint32_t* active = nullptr;
+  uint32_t count = 0;  // with active
 };
 
 // A small image fills the GPU with too few threads at one a pixel (at 512 x 384 an
@@ -27,18 +31,18 @@ struct MegakernelOut {
 // samples (and 1024). 1: one thread a pixel (1920 x 1080 on 132 SMs, and larger).
 int megakernel_batch(int64_t pixels, int sm_count, int pass_samples);
 
-// Adds samples [first_sample, first_sample + samples) of every pixel to out.film (RGB
-// sums), or stores each in out.radiance (samples x pixels x 3 floats), and the path
-// rays they intersect to rays[0] and the shadow rays to rays[1].
+// Adds samples [first_sample, first_sample + samples) of the work's pixels to its film
+// (RGB sums), or stores each in its radiance, and the path rays they intersect to
+// rays[0] and the shadow rays to rays[1].
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples,
-                       MegakernelOut out, unsigned long long* rays, cudaStream_t stream);
+                       MegakernelWork out, unsigned long long* rays, cudaStream_t stream);
 
 // Adds a batch's stored samples (`samples` of them, in sample order) to each pixel's
 // running sum (from zero where `first`), and where `last` (the pass's last batch) the
 // sum to the film: the additions of the one-thread-a-pixel loop, in its order, so
 // that batches change no bit of the image.
-void launch_megakernel_fold(const RenderParams& rp, int samples, const float* radiance, float* running, float* film,
-                            bool first, bool last, cudaStream_t stream);
+void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork work, float* running, bool first,
+                            bool last, cudaStream_t stream);
 
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();
@@ -47,7 +51,7 @@ size_t constant_scene_capacity();
 // `images` are the device image views (texture objects) of the uploaded scene.
 void upload_constant_scene(const Scene& scene, const SceneView& device_view, const std::vector<ImageView>& images);
 
-void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelOut out,
+void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelWork out,
                                 unsigned long long* rays, cudaStream_t stream);
 
 }  // namespace wt::cuda

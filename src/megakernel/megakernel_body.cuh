@@ -2,6 +2,8 @@
 // variants: they differ only in the scene accessor.
 #pragma once
 
+#include <algorithm>
+
 #include "wavetrace/path.hpp"
 
 namespace wt::cuda {
@@ -16,14 +18,17 @@ constexpr int kMegakernelBlockY = 8;
 // batch's samples up in the order the loop would have.
 template <uint32_t Kinds, class Scene>
 __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const RenderParams& rp, int first_sample,
-                                                 int samples, MegakernelOut out, unsigned long long* rays) {
+                                                 int samples, MegakernelWork out, unsigned long long* rays) {
   // rays[0]: path rays; rays[1]: shadow rays.
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   const int z = static_cast<int>(blockIdx.z);
+  // The thread's place in the work's pixels, and its pixel.
+  const uint32_t index = static_cast<uint32_t>(y) * rp.width + x;
+  const uint32_t pixels = out.active ? out.count : static_cast<uint32_t>(rp.width) * rp.height;
   uint32_t count = 0, shadow_count = 0;
-  if (x < rp.width && y < rp.height && (!out.radiance || z < samples)) {
-    const uint32_t pixel = static_cast<uint32_t>(y) * rp.width + x;
+  if (x < rp.width && index < pixels && (!out.radiance || z < samples)) {
+    const uint32_t pixel = out.active ? out.active[index] : index;
     // One call of trace_path in the kernel, whichever way: it is most of its code.
     const int begin = out.radiance ? first_sample + z : first_sample;
     const int end = out.radiance ? begin + 1 : first_sample + samples;
@@ -33,7 +38,7 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
     }
     if (out.radiance) {
       // 0 + L is L: the sample as trace_path returned it.
-      float* r = out.radiance + 3 * (static_cast<size_t>(z) * rp.width * rp.height + pixel);
+      float* r = out.radiance + 3 * (static_cast<size_t>(z) * pixels + index);
       r[0] = sum.x;
       r[1] = sum.y;
       r[2] = sum.z;
@@ -57,11 +62,13 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
   }
 }
 
-// The launch's grid: the image's blocks, `batch` deep where the samples are a batch
-// (one thread a pixel and sample), else one deep.
-inline dim3 megakernel_grid(const RenderParams& rp, int batch = 1) {
+// The launch's grid: the image's blocks (or the rows the work's listed pixels fill,
+// read a row of the image's width at a time), `batch` deep where the samples are a
+// batch (one thread a pixel and sample), else one deep.
+inline dim3 megakernel_grid(const RenderParams& rp, int batch, const MegakernelWork& work) {
+  const uint32_t rows = work.active ? (work.count + rp.width - 1) / rp.width : static_cast<uint32_t>(rp.height);
   return dim3((rp.width + kMegakernelBlockX - 1) / kMegakernelBlockX,
-              (rp.height + kMegakernelBlockY - 1) / kMegakernelBlockY, static_cast<unsigned>(batch));
+              std::max<uint32_t>(1, (rows + kMegakernelBlockY - 1) / kMegakernelBlockY), static_cast<unsigned>(batch));
 }
 
 }  // namespace wt::cuda

@@ -61,7 +61,7 @@ size_t align16(size_t n) { return (n + 15) & ~size_t(15); }
 
 template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
-    megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, MegakernelOut out,
+    megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, MegakernelWork out,
                         unsigned long long* rays) {
   megakernel_pixel<Kinds>(scene, rp, first_sample, samples, out, rays);
 }
@@ -95,9 +95,9 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   g_kinds = device_view.kinds;
 }
 
-void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelOut out,
+void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelWork out,
                                 unsigned long long* rays, cudaStream_t stream) {
-  const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1), block(kMegakernelBlockX, kMegakernelBlockY);
+  const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1, out), block(kMegakernelBlockX, kMegakernelBlockY);
   const uint32_t kinds_and_lights = g_kinds | (g_scene.samples_lights(rp) ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {
     megakernel_constant<decltype(kinds)::value>

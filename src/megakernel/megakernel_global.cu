@@ -8,7 +8,7 @@ namespace wt::cuda {
 
 template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
-    megakernel_global(SceneView scene, RenderParams rp, int first_sample, int samples, MegakernelOut out,
+    megakernel_global(SceneView scene, RenderParams rp, int first_sample, int samples, MegakernelWork out,
                       unsigned long long* rays) {
   megakernel_pixel<Kinds>(scene, rp, first_sample, samples, out, rays);
 }
@@ -16,17 +16,18 @@ __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
 // Thread per pixel: the pixel's sums of the batch's earlier samples (`running`,
 // where `first` is false) plus each of this batch's in turn; the pass's last batch
 // adds the sum to the film, the others keep it in `running`.
-__global__ void megakernel_fold(RenderParams rp, int samples, const float* radiance, float* running, float* film,
-                                bool first, bool last) {
-  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
-  const size_t pixel = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (pixel >= pixels) return;
-  vec3 sum = first ? vec3(0.0f) : vec3(running[3 * pixel], running[3 * pixel + 1], running[3 * pixel + 2]);
+__global__ void megakernel_fold(RenderParams rp, int samples, MegakernelWork work, float* running, bool first,
+                                bool last) {
+  const size_t pixels = work.active ? work.count : static_cast<size_t>(rp.width) * rp.height;
+  const size_t index = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (index >= pixels) return;
+  const size_t pixel = work.active ? work.active[index] : index;
+  vec3 sum = first ? vec3(0.0f) : vec3(running[3 * index], running[3 * index + 1], running[3 * index + 2]);
   for (int j = 0; j < samples; ++j) {
-    const float* r = radiance + 3 * (j * pixels + pixel);
+    const float* r = work.radiance + 3 * (j * pixels + index);
     sum += vec3(r[0], r[1], r[2]);
   }
-  float* f = last ? film + 3 * pixel : running + 3 * pixel;
+  float* f = last ? work.film + 3 * pixel : running + 3 * index;
   if (last) {
     f[0] += sum.x;
     f[1] += sum.y;
@@ -44,18 +45,18 @@ int megakernel_batch(int64_t pixels, int sm_count, int pass_samples) {
   return static_cast<int>(std::clamp<int64_t>(batch, 1, std::clamp(pass_samples, 1, 1024)));
 }
 
-void launch_megakernel_fold(const RenderParams& rp, int samples, const float* radiance, float* running, float* film,
-                            bool first, bool last, cudaStream_t stream) {
-  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork work, float* running, bool first,
+                            bool last, cudaStream_t stream) {
+  const size_t pixels = work.active ? work.count : static_cast<size_t>(rp.width) * rp.height;
   constexpr unsigned kBlock = 256;
   megakernel_fold<<<static_cast<unsigned>((pixels + kBlock - 1) / kBlock), kBlock, 0, stream>>>(
-      rp, samples, radiance, running, film, first, last);
+      rp, samples, work, running, first, last);
   WT_CUDA_LAUNCHED("megakernel_fold", "megakernel");
 }
 
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples,
-                       MegakernelOut out, unsigned long long* rays, cudaStream_t stream) {
-  const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1), block(kMegakernelBlockX, kMegakernelBlockY);
+                       MegakernelWork out, unsigned long long* rays, cudaStream_t stream) {
+  const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1, out), block(kMegakernelBlockX, kMegakernelBlockY);
   // Light sampling's code is compiled in only where the scene has emitters to sample.
   const uint32_t kinds_and_lights = scene.kinds | (scene.samples_lights(rp) ? kLightSampling : 0u);
   with_kinds(kinds_and_lights, [&](auto kinds) {

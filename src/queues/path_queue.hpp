@@ -44,6 +44,23 @@ WT_HD WT_INLINE uint32_t path_pixel(uint32_t path, uint32_t width, uint32_t heig
   return (y0 + r / w) * width + x0 + r % w;
 }
 
+// The pixels a pass's samples visit: every pixel (`active` null), in path_pixel's
+// tiles, or the `count` listed (adaptive sampling's pixels still going), in the
+// list's order. Path `path` of the pass is sample first + path / pixels of pixel
+// pass_pixel(path).
+struct PassPixels {
+  const uint32_t* active = nullptr;
+  uint32_t count = 0;  // with `active`
+};
+
+WT_HD WT_INLINE uint32_t pass_pixels(const PassPixels& pass, uint32_t width, uint32_t height) {
+  return pass.active ? pass.count : width * height;
+}
+
+WT_HD WT_INLINE uint32_t pass_pixel(uint32_t path, const PassPixels& pass, uint32_t width, uint32_t height) {
+  return pass.active ? pass.active[path % pass.count] : path_pixel(path, width, height);
+}
+
 // A light sample waiting for its shadow ray (path.hpp's ShadowRay, and the pixel
 // it lights).
 struct ShadowState {

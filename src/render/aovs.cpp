@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 #include "errors/errors.hpp"
 #include "wavetrace/aov.hpp"
@@ -9,7 +10,7 @@
 namespace wt {
 
 const std::vector<std::string>& aov_names() {
-  static const std::vector<std::string> names = {"albedo", "normal", "depth", "position"};
+  static const std::vector<std::string> names = {"albedo", "normal", "depth", "position", "variance", "spp"};
   return names;
 }
 
@@ -82,6 +83,27 @@ AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples
       image.channels = {"X", "Y", "Z"};
       image.values = means(sums, kAovPosition, 3, samples, true, 0.0f);
       break;
+    case AovKind::Variance:
+    case AovKind::Spp:
+      throw std::logic_error("aov_image: the render's own AOV, not the first-surface pass's");
+  }
+  return image;
+}
+
+bool from_first_surface(AovKind kind) { return kind != AovKind::Variance && kind != AovKind::Spp; }
+
+AovImage result_aov_image(AovKind kind, const RenderResult& result) {
+  AovImage image{kind, aov_name(kind), {}, {}};
+  if (kind == AovKind::Variance) {
+    image.channels = {"R", "G", "B"};
+    image.values = result.variance;
+  } else {
+    image.channels = {"Y"};
+    const size_t pixels = result.rgb.size() / 3;
+    image.values.assign(pixels, static_cast<float>(result.samples));
+    for (size_t p = 0; p < result.pixel_samples.size() && p < pixels; ++p) {
+      image.values[p] = static_cast<float>(result.pixel_samples[p]);
+    }
   }
   return image;
 }

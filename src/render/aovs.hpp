@@ -6,11 +6,15 @@
 #include <string>
 #include <vector>
 
+#include "render/render_types.hpp"
+
 namespace wt {
 
-enum class AovKind : uint32_t { Albedo, Normal, Depth, Position };
+enum class AovKind : uint32_t { Albedo, Normal, Depth, Position, Variance, Spp };
 
-// The AOVs' names, as --aov takes them: "albedo", "normal", "depth", "position".
+// The AOVs' names, as --aov takes them: "albedo", "normal", "depth", "position"
+// (the first-surface pass's), "variance" and "spp" (the render's own: adaptive
+// sampling's estimate of the variance of each pixel's mean, and its samples).
 const std::vector<std::string>& aov_names();
 const char* aov_name(AovKind kind);
 
@@ -36,11 +40,17 @@ struct AovImage {
   std::vector<float> values;
 };
 
+// Whether the AOV comes from the first-surface pass (else from the render itself).
+bool from_first_surface(AovKind kind);
+
 // The AOV `kind` of a render from the first-surface pass's sums over `samples`
 // samples a pixel (kAovFloats a pixel): albedo and normal are means over every
 // sample; depth and position means over the samples that hit a surface, a pixel none
 // of whose samples did holding an infinite depth and a zero position.
 AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples);
+// The AOV `kind` (variance or spp) of the render's result: the variance of each
+// pixel's mean (R, G, B; render/adaptive.hpp), its samples (Y).
+AovImage result_aov_image(AovKind kind, const RenderResult& result);
 
 // The albedo and normal as OIDN takes them: the albedo's mean clamped to [0, 1], the
 // normal's mean.

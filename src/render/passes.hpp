@@ -44,7 +44,7 @@ inline std::vector<SamplePass> plan_passes(uint64_t pixels, int32_t first, int32
 inline std::vector<SamplePass> plan_passes(const RenderOptions& o, int32_t min_passes, uint64_t min_paths = 0) {
   const RenderParams& rp = o.params;
   const int32_t count = o.sample_count > 0 ? o.sample_count : rp.spp - o.first_sample;
-  return plan_passes(static_cast<uint64_t>(rp.width) * rp.height, o.first_sample, count, min_passes,
+  return plan_passes(std::max<uint64_t>(rendered_pixels(o), 1), o.first_sample, count, min_passes,
                      o.samples_per_pass, o.max_paths_per_pass, min_paths);
 }
 

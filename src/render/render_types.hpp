@@ -126,7 +126,23 @@ struct RenderOptions {
   // (megakernel_batch): 0 chooses by the image's size and the device's; 1 is one
   // thread a pixel; tests set others. The image is the same bit for bit.
   int32_t megakernel_batch = 0;
+  // Only these pixels (ascending indices; adaptive sampling's pixels still going,
+  // render/adaptive.hpp): the render traces samples [first_sample, first_sample +
+  // sample_count) of each and adds them to the film at their pixels, the others'
+  // sums left as they are. Null: every pixel. One device, no path feed.
+  const std::vector<uint32_t>* active_pixels = nullptr;
+  // Adaptive sampling (render/adaptive.hpp; render() only): above 0, each pixel stops
+  // once its neighbourhood's relative error is at most this, after at least
+  // `min_spp` samples (0: 16, or spp where less) and at most params.spp. Below 0:
+  // the same rounds with no pixel stopping (for the variance they estimate). 0: off.
+  double noise_threshold = 0;
+  int32_t min_spp = 0;
 };
+
+// The pixels a render's samples visit: those listed, or every one.
+inline uint64_t rendered_pixels(const RenderOptions& o) {
+  return o.active_pixels ? o.active_pixels->size() : static_cast<uint64_t>(o.params.width) * o.params.height;
+}
 
 // What one device did in a render split over several (dispatch/split.hpp).
 struct DeviceShare {
@@ -166,6 +182,12 @@ struct RenderResult {
   uint64_t bounces_shaded = 0, bounces_sorted = 0;
   uint64_t blocks = 0;  // wavefront with a path feed: the blocks of paths it took
   std::vector<DeviceShare> shares;  // a render split over several devices: each one's part
+  // An adaptive render (render/adaptive.hpp): each pixel's samples, the variance of
+  // each pixel's mean (3 floats a pixel), and the pixels that converged; `samples` is
+  // then the most any pixel took.
+  std::vector<int32_t> pixel_samples;
+  std::vector<float> variance;
+  uint64_t converged = 0;
 };
 
 }  // namespace wt

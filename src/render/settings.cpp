@@ -27,6 +27,8 @@ const std::vector<Setting>& settings() {
       {SettingId::MegakernelBatch, "megakernel_batch", "--megakernel-batch", SettingType::Int32, 0, 1024, 0,
        "CUDA megakernels: samples a launch of one thread a pixel and sample takes (default 0: chosen by the "
        "image's size and the device's; 1: one thread a pixel); the image is the same"},
+      {SettingId::MinSpp, "min_spp", "--min-spp", SettingType::Int32, 0, kMaxSpp, 0,
+       "with --noise-threshold: the samples every pixel takes first (default 0: 16, or spp where less)"},
   };
   return table;
 }

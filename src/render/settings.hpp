@@ -41,7 +41,8 @@ enum class SettingId {
   WaveSize,
   Threads,
   CheckpointEvery,
-  MegakernelBatch
+  MegakernelBatch,
+  MinSpp
 };
 
 enum class SettingType { Int32, UInt32, Int64 };

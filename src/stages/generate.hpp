@@ -10,17 +10,17 @@
 namespace wt {
 
 // The path that free slot `slot` (>= queued) starts: path next_path + (slot - queued)
-// of the pass whose first sample is `first_sample`.
+// of the pass whose first sample is `first_sample`, over the pass's pixels.
 template <class Scene>
 WT_HD WT_INLINE PathState start_path(uint32_t slot, uint32_t queued, uint32_t next_path, uint32_t first_sample,
-                                     const Scene& scene, const RenderParams& rp) {
-  const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
+                                     const Scene& scene, const RenderParams& rp, const PassPixels& pass = {}) {
+  const uint32_t pixels = pass_pixels(pass, rp.width, rp.height);
   PathState s;
   s.path = next_path + (slot - queued);
   s.bounce = 0;
   s.throughput = vec3(1.0f);
   s.pdf = 0.0f;
-  s.ray = primary_ray(scene, rp, path_pixel(s.path, rp.width, rp.height), first_sample + s.path / pixels);
+  s.ray = primary_ray(scene, rp, pass_pixel(s.path, pass, rp.width, rp.height), first_sample + s.path / pixels);
   return s;
 }
 

@@ -17,12 +17,13 @@ namespace wt {
 // queue. Kinds: the primitive kinds the scene holds (a superset gives the same hits).
 template <uint32_t Kinds = kAllKinds, class Scene>
 WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& scene, const RenderParams& rp,
-                                       const PathQueue& q, const HitQueue& hits, float* film) {
+                                       const PathQueue& q, const HitQueue& hits, float* film,
+                                       const PassPixels& pass = {}) {
   Hit h = intersect_scene<Kinds>(scene, ray);
   store_hit<Kinds>(hits, i, h);
   if (h.missed()) {
     vec3 t(q.tr[i], q.tg[i], q.tb[i]);
-    accumulate_one(film, path_pixel(q.path[i], rp.width, rp.height), t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
+    accumulate_one(film, pass_pixel(q.path[i], pass, rp.width, rp.height), t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
     return pack_entry(kSortKeyMiss, i);
   }
   return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);
@@ -54,6 +55,7 @@ struct IntersectItem {
   uint32_t first_sample;  // of this pass
   uint32_t capacity;
   float* film;
+  PassPixels pass{};  // the pass's pixels: every one by default
 
   WT_HD void operator()(uint32_t i) const {
     const uint32_t queued = counters->queued[cur];
@@ -64,13 +66,13 @@ struct IntersectItem {
     }
     Ray ray;
     if (i >= queued) {
-      const PathState s = start_path(i, queued, next_path, first_sample, scene, rp);
+      const PathState s = start_path(i, queued, next_path, first_sample, scene, rp, pass);
       queue.store(i, s);
       ray = s.ray;
     } else {
       ray = queued_ray(queue, i);
     }
-    const uint32_t entry = intersect_one<Kinds>(i, ray, scene, rp, queue, hits, film);
+    const uint32_t entry = intersect_one<Kinds>(i, ray, scene, rp, queue, hits, film, pass);
     entries[i] = entry;
     const uint32_t key = entry_key(entry);
     or_bits(&counters->key_mask[cur], key < kSortKeyMiss ? 1u << key : 0u);

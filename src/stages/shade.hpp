@@ -18,10 +18,10 @@ template <uint32_t Kinds = kEverything, class Scene>
 // `shadow` (with shadow.valid) is the light sample taken there, for `pixel`.
 WT_HD WT_INLINE bool shade_one(uint32_t slot, uint32_t first_sample, const Scene& scene, const RenderParams& rp,
                                const PathQueue& q, const HitQueue& hits, float* film, PathState& next,
-                               ShadowRay& shadow, uint32_t& pixel) {
+                               ShadowRay& shadow, uint32_t& pixel, const PassPixels& pass = {}) {
   PathState s = q.load(slot);
-  const uint32_t pixels = static_cast<uint32_t>(rp.width) * rp.height;
-  pixel = path_pixel(s.path, rp.width, rp.height);
+  const uint32_t pixels = pass_pixels(pass, rp.width, rp.height);
+  pixel = pass_pixel(s.path, pass, rp.width, rp.height);
   vec3 radiance(0.0f);
   bool alive = shade_hit<Kinds>(scene, rp, load_hit<Kinds>(hits, slot), pixel, first_sample + s.path / pixels, s.bounce, s.ray,
                                 s.throughput, radiance, s.pdf, shadow);
@@ -45,6 +45,7 @@ struct ShadeItem {
   const uint32_t* list;
   uint32_t first_sample;  // of this pass
   float* film;
+  PassPixels pass{};  // the pass's pixels: every one by default
 
   // Forced inline: called through the executor, a shade too large for nvcc's own
   // choice becomes a call with a 736-byte stack frame (the microfacet kernels, 2x
@@ -54,7 +55,7 @@ struct ShadeItem {
     ShadowRay shadow;
     uint32_t pixel;
     const bool alive =
-        shade_one<Kinds>(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next, shadow, pixel);
+        shade_one<Kinds>(entry_slot(list[i]), first_sample, scene, rp, queue, hits, film, next, shadow, pixel, pass);
     // Every item reaches the pushes, so that a warp reserves its slots with one atomic.
     const uint32_t slot = push_slot(next_count, alive);
     if (alive) next_queue.store(slot, next);

@@ -91,7 +91,8 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const RenderParams& rp = options.params;
   const bool light_sampling = scene.samples_lights(rp);
   const uint32_t shade_kinds = scene.kinds | (light_sampling ? kLightSampling : 0u);
-  const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
+  // The pixels a sample of a pass visits (options.active_pixels, or every one).
+  const uint64_t pixels = rendered_pixels(options);
   // Passes asked for (for checkpoints) hold at least four waves' paths: every pass
   // ends with the wave draining, which a full wave's regeneration otherwise hides.
   // (With a feed every device must plan the same passes: none asked for, none by capacity.)
@@ -100,7 +101,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   const uint64_t all_paths = pixels * static_cast<uint64_t>(passes.empty() ? 0 : passes.back().first +
                                                                                    passes.back().count - passes.front().first);
   const uint32_t slots = static_cast<uint32_t>(capacity);
-  const size_t film_floats = static_cast<size_t>(pixels) * 3;
+  const size_t film_floats = static_cast<size_t>(rp.width) * rp.height * 3;
 
   size_t bytes = 0;
   const size_t temp_bytes = Exec::temp_bytes(slots);
@@ -110,6 +111,15 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
   auto key_memory = ex.alloc(options.shade_by_kind ? sizeof(KeyStarts) : 0, "wave allocation");
   KeyStarts* const key_starts = reinterpret_cast<KeyStarts*>(key_memory.get());
   float* film = options.device_film ? options.device_film : reinterpret_cast<float*>(film_memory.get());
+  // The listed pixels, where the device reads them.
+  auto active_memory = ex.alloc(options.active_pixels ? options.active_pixels->size() * sizeof(uint32_t) : 0,
+                                "wave allocation");
+  PassPixels pass_pixels_of{};
+  if (options.active_pixels && !options.active_pixels->empty()) {
+    uint32_t* active = reinterpret_cast<uint32_t*>(active_memory.get());
+    ex.upload(active, *options.active_pixels);
+    pass_pixels_of = PassPixels{active, static_cast<uint32_t>(options.active_pixels->size())};
+  }
 
   RenderResult out;
   auto run = [&](bool last) {
@@ -149,7 +159,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         with_kinds<false, false, true>(scene.kinds, [&](auto kinds) {
           ex.launch(stage::kIntersect, slots,
                     IntersectItem<decltype(kinds)::value>{scene, rp, w.queue[cur], w.hits, w.entries, w.counters, cur, limit, first,
-                                           slots, film});
+                                           slots, film, pass_pixels_of});
         });
         ex.launch(stage::kIntersect, 1, AdvanceCountersItem{w.counters, cur, limit, slots});
         ex.select(stage::kCompact, w.entries, w.selected, &w.counters->hits, slots, HitSomething{}, w.temp,
@@ -194,7 +204,7 @@ RenderResult render_wavefront(Exec& ex, const SceneView& scene, int key_bits, co
         with_kinds(shade_kinds, [&](auto kinds) {
           using Item = ShadeItem<decltype(kinds)::value>;
           const Item item{scene, rp, w.queue[cur], w.hits, w.queue[1 - cur], &w.counters->queued[1 - cur], w.shadows,
-                          &w.counters->shadows, list, first, film};
+                          &w.counters->shadows, list, first, film, pass_pixels_of};
           if (!by_kind) {
             ex.launch(stage::kShade, c.hits, item);
           } else {

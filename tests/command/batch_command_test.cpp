@@ -432,7 +432,7 @@ TEST_F(BatchCommand, AovsAreFilesBesideTheImageOrLayersOfItsExr) {
 TEST_F(BatchCommand, AovsBadInputIsOneLineAndNoFile) {
   const std::string render = "render '" + path("s.json") + "' -o '" + path("o.png") + "' --backend cpu --width 8 --height 8 --spp 1 -q";
   EXPECT_EQ(wavetrace(render + " --aov albedo,shadow"), 2) << err_;
-  EXPECT_NE(err_.find("--aov: unknown AOV 'shadow' (known: albedo, normal, depth, position)"), std::string::npos) << err_;
+  EXPECT_NE(err_.find("--aov: unknown AOV 'shadow' (known: albedo, normal, depth, position, variance, spp)"), std::string::npos) << err_;
   EXPECT_EQ(count(err_, "\n"), 1u) << err_;
   fs::create_directories(path("o.albedo.pfm"));
   EXPECT_EQ(wavetrace(render + " --aov albedo"), 2) << err_;
@@ -456,6 +456,54 @@ TEST_F(BatchCommand, AovsBadInputIsOneLineAndNoFile) {
   EXPECT_NE(err_.find("k.depth.pfm"), std::string::npos) << err_;
   EXPECT_FALSE(fs::exists(path("k.png")));
   EXPECT_FALSE(fs::exists(path("k.depth.pfm")));
+}
+
+// --noise-threshold: an adaptive render; its stats say how it ended, its spp AOV
+// is each pixel's samples, the same whichever kernel renders it; a jobs file's
+// noise_threshold and min_spp do the same.
+TEST_F(BatchCommand, AnAdaptiveRenderSaysHowItEnded) {
+  const std::string common = "' --backend cpu --width 24 --height 16 --spp 256 -q --seed 5 --noise-threshold 0.05"
+                             " --min-spp 8 --aov spp,variance";
+  ASSERT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("a.pfm") + common + " --stats '" + path("a.json") +
+                      "'"),
+            0)
+      << err_;
+  ASSERT_EQ(wavetrace("render '" + path("s.json") + "' -o '" + path("b.pfm") + common + " --kernel wavefront"), 0)
+      << err_;
+  EXPECT_EQ(read(path("a.spp.pfm")), read(path("b.spp.pfm")));
+  EXPECT_EQ(read(path("a.spp.pfm")).rfind("Pf\n24 16\n-1.0\n", 0), 0u);
+  EXPECT_EQ(read(path("a.variance.pfm")).rfind("PF\n24 16\n-1.0\n", 0), 0u);
+  const std::string stats = read(path("a.json"));
+  EXPECT_NE(stats.find("\"adaptive\""), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"converged_pixels\""), std::string::npos) << stats;
+  EXPECT_NE(stats.find("\"noise_threshold\": 0.05"), std::string::npos) << stats;
+  std::ofstream(path("jobs.json")) << R"({"jobs": [{"scene": "s.json", "output": "j.pfm", "backend": "cpu",
+    "width": 16, "height": 8, "spp": 64, "noise_threshold": 0.1, "min_spp": 4, "aov": "spp"}]})";
+  EXPECT_EQ(batch("'" + path("jobs.json") + "'"), 0) << err_;
+  EXPECT_TRUE(fs::exists(path("j.spp.pfm")));
+}
+
+// A threshold that is not above 0, min_spp above spp or without a threshold, and an
+// adaptive render with a checkpoint: one line and exit 2, no file.
+TEST_F(BatchCommand, AdaptiveSamplingsBadInputIsOneLineAndNoFile) {
+  const std::string render = "render '" + path("s.json") + "' -o '" + path("o.png") + "' --backend cpu --width 8 --height 8 --spp 16 -q";
+  for (const auto& [args, message] :
+       {std::pair<std::string, std::string>{" --noise-threshold 0", "--noise-threshold: must be above 0 (got 0)"},
+        {" --noise-threshold -0.5", "--noise-threshold: must be above 0 (got -0.5)"},
+        {" --noise-threshold 0.1 --min-spp 32", "--min-spp: 32 is more than the 16 samples per pixel"},
+        {" --min-spp 4", "--min-spp: the samples every pixel takes before adaptive sampling stops any; give --noise-threshold too"},
+        {" --noise-threshold 0.1 --checkpoint '" + path("c.ckpt") + "'", "--noise-threshold: an adaptive render keeps no checkpoint yet"}}) {
+    SCOPED_TRACE(args);
+    EXPECT_EQ(wavetrace(render + args), 2) << err_;
+    EXPECT_NE(err_.find(message), std::string::npos) << err_;
+    EXPECT_EQ(count(err_, "\n"), 1u) << err_;
+    EXPECT_FALSE(fs::exists(path("o.png")));
+  }
+  std::ofstream(path("jobs.json")) << R"({"jobs": [{"scene": "s.json", "output": "j.png", "backend": "cpu",
+    "width": 8, "height": 8, "spp": 4, "noise_threshold": 0}]})";
+  EXPECT_NE(batch("'" + path("jobs.json") + "'"), 0) << err_;
+  EXPECT_NE(err_.find("/jobs/0/noise_threshold"), std::string::npos) << err_;
+  EXPECT_FALSE(fs::exists(path("j.png")));
 }
 
 }  // namespace

@@ -1,0 +1,160 @@
+#include "render/adaptive.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace wt {
+
+void mean_variance(const PixelHalves& h, double v[3]) {
+  const double n = static_cast<double>(h.n_a) + h.n_b;
+  for (int c = 0; c < 3; ++c) {
+    if (h.n_a == 0 || h.n_b == 0) {
+      v[c] = 0.0;
+      continue;
+    }
+    const double d = h.a[c] / h.n_a - h.b[c] / h.n_b;
+    v[c] = d * d * (static_cast<double>(h.n_a) * h.n_b) / (n * n);
+  }
+}
+
+double relative_error_squared(const PixelHalves& h) {
+  if (h.n_a == 0 || h.n_b == 0) return 0.0;
+  const double n = static_cast<double>(h.n_a) + h.n_b;
+  const double ya = luminance(h.a[0], h.a[1], h.a[2]) / h.n_a;
+  const double yb = luminance(h.b[0], h.b[1], h.b[2]) / h.n_b;
+  const double y = (ya * h.n_a + yb * h.n_b) / n;
+  const double d = ya - yb;
+  const double v = d * d * (static_cast<double>(h.n_a) * h.n_b) / (n * n);
+  const double scale = std::max(y, kNoiseFloor);
+  return v / (scale * scale);
+}
+
+std::vector<uint8_t> converged_pixels(const std::vector<double>& r2, int width, int height, double threshold) {
+  std::vector<uint8_t> done(r2.size(), 0);
+  const double t2 = threshold * threshold;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      double sum = 0.0;
+      int count = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = y + dy;
+          if (qx < 0 || qy < 0 || qx >= width || qy >= height) continue;
+          sum += r2[static_cast<size_t>(qy) * width + qx];
+          ++count;
+        }
+      }
+      done[static_cast<size_t>(y) * width + x] = sum <= t2 * count ? 1 : 0;
+    }
+  }
+  return done;
+}
+
+int32_t step_samples(int32_t n, int32_t min_spp, int32_t spp) {
+  int32_t k = std::max(min_spp, n / 4);
+  k += k & 1;
+  return std::max<int32_t>(0, std::min(k, spp - n));
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& options, double threshold,
+                             int32_t min_spp) {
+  const RenderParams& rp = options.params;
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  // Each half's sums: the rounds' films added on the host.
+  std::vector<float> half_a(pixels * 3, 0.0f), half_b(pixels * 3, 0.0f);
+  std::vector<int32_t> n_a(pixels, 0), n_b(pixels, 0);
+  std::vector<uint8_t> done(pixels, 0);
+  std::vector<uint32_t> active(pixels);
+  for (size_t p = 0; p < pixels; ++p) active[p] = static_cast<uint32_t>(p);
+
+  RenderResult out;
+  const auto t0 = Clock::now();
+  int32_t n = 0;  // the samples every active pixel has
+  const int32_t first_step = std::min(std::max(min_spp, 2), rp.spp);
+  // Rendered paths over all the render could take (progress's fraction).
+  const double all_paths = static_cast<double>(pixels) * rp.spp;
+  auto round = [&](int32_t count, bool into_a) {
+    if (count <= 0 || active.empty()) return;
+    RenderOptions o = options;
+    o.first_sample = n;
+    o.sample_count = count;
+    o.active_pixels = active.size() == pixels ? nullptr : &active;
+    o.progress = nullptr;
+    o.after_pass = nullptr;
+    o.initial_film = nullptr;
+    o.warmup = 0;
+    const RenderResult r = render(o);
+    std::vector<float>& half = into_a ? half_a : half_b;
+    std::vector<int32_t>& counts = into_a ? n_a : n_b;
+    for (uint32_t p : active) {
+      for (int c = 0; c < 3; ++c) half[3 * p + c] += r.rgb[3 * p + c];
+      counts[p] += count;
+    }
+    out.rays += r.rays;
+    out.shadow_rays += r.shadow_rays;
+    out.paths += r.paths;
+    out.seconds += r.seconds;
+    out.upload_seconds = r.upload_seconds;
+    out.device = r.device;
+    n += count;
+    if (options.progress) {
+      options.progress(std::min(1.0, static_cast<double>(out.paths) / all_paths), out.rays,
+                       std::chrono::duration<double>(Clock::now() - t0).count());
+    }
+  };
+  for (int32_t step = first_step; step > 0 && !active.empty(); step = step_samples(n, min_spp, rp.spp)) {
+    const int32_t a = step / 2, b = step - step / 2;
+    round(a, true);
+    round(b, false);
+    // Which pixels go on: those whose neighbourhood is still above the threshold.
+    std::vector<double> r2(pixels, 0.0);
+    for (size_t p = 0; p < pixels; ++p) {
+      const PixelHalves h{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
+                          {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
+                          n_a[p],
+                          n_b[p]};
+      r2[p] = relative_error_squared(h);
+    }
+    const std::vector<uint8_t> now = converged_pixels(r2, rp.width, rp.height, threshold);
+    std::vector<uint32_t> going;
+    for (uint32_t p : active) {
+      if (now[p]) {
+        done[p] = 1;
+      } else {
+        going.push_back(p);
+      }
+    }
+    active = std::move(going);
+  }
+
+  out.rgb.assign(pixels * 3, 0.0f);
+  out.variance.assign(pixels * 3, 0.0f);
+  out.pixel_samples.assign(pixels, 0);
+  for (size_t p = 0; p < pixels; ++p) {
+    const int32_t count = n_a[p] + n_b[p];
+    out.pixel_samples[p] = count;
+    const PixelHalves h{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
+                        {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
+                        n_a[p],
+                        n_b[p]};
+    double v[3];
+    mean_variance(h, v);
+    for (int c = 0; c < 3; ++c) {
+      out.rgb[3 * p + c] = count > 0 ? static_cast<float>((half_a[3 * p + c] + half_b[3 * p + c]) / count) : 0.0f;
+      out.variance[3 * p + c] = static_cast<float>(v[c]);
+    }
+    out.converged += done[p];
+  }
+  out.samples = n;
+  out.radiance = Radiance::MeanOfSamples;
+  return out;
+}
+
+}  // namespace wt
