@@ -109,6 +109,16 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
                        std::chrono::duration<double>(Clock::now() - t0).count());
     }
   };
+  // Warm-ups, as every kernel runs them: the first round's samples, untimed and
+  // dropped.
+  for (int i = 0; i < options.warmup; ++i) {
+    RenderOptions o = options;
+    o.sample_count = std::max(1, first_step / 2);
+    o.progress = nullptr;
+    o.after_pass = nullptr;
+    o.warmup = 0;
+    render(o);
+  }
   for (int32_t step = first_step; step > 0 && !active.empty(); step = step_samples(n, min_spp, rp.spp)) {
     const int32_t a = step / 2, b = step - step / 2;
     round(a, true);
