@@ -544,6 +544,11 @@ void print_outcome(const Job& job, const JobOutcome& o) {
                  o.wall_seconds);
   }
   const double pixels = static_cast<double>(o.params.width) * o.params.height;
+  if (job.noise_threshold && pixels > 0) {
+    std::fprintf(stderr, "  adaptive: %llu of %.0f pixels converged under %g; %.1f spp on average, %d at most\n",
+                 static_cast<unsigned long long>(r.converged), pixels, *job.noise_threshold,
+                 static_cast<double>(r.paths) / pixels, r.samples);
+  }
   for (const DeviceShare& s : r.shares) {
     // Chunks of samples, or (a wavefront's devices sharing the paths) blocks of paths.
     std::fprintf(stderr, "  %s (%s): %.1f spp in %d %s, %.3f s, %.1f M rays/s\n", s.device.c_str(), s.name.c_str(),
