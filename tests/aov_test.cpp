@@ -51,10 +51,10 @@ TEST(Aovs, ALambertianSphereAndTheSkyAreWhatTheyAre) {
   const AovSums sums = render_aovs(scene, aov_options(Backend::Cpu));
   ASSERT_EQ(sums.samples, 16);
   ASSERT_EQ(sums.sums.size(), static_cast<size_t>(kSize) * kSize * kAovFloats);
-  const AovImage albedo = aov_image(AovKind::Albedo, sums.sums, sums.samples);
-  const AovImage normal = aov_image(AovKind::Normal, sums.sums, sums.samples);
-  const AovImage depth = aov_image(AovKind::Depth, sums.sums, sums.samples);
-  const AovImage position = aov_image(AovKind::Position, sums.sums, sums.samples);
+  const AovImage albedo = aov_image(AovKind::Albedo, sums);
+  const AovImage normal = aov_image(AovKind::Normal, sums);
+  const AovImage depth = aov_image(AovKind::Depth, sums);
+  const AovImage position = aov_image(AovKind::Position, sums);
   EXPECT_EQ(albedo.channels, (std::vector<std::string>{"R", "G", "B"}));
   EXPECT_EQ(normal.channels, (std::vector<std::string>{"X", "Y", "Z"}));
   EXPECT_EQ(depth.channels, (std::vector<std::string>{"Z"}));
@@ -95,9 +95,9 @@ TEST(Aovs, AMirrorShowsTheAlbedoAndNormalOfWhatItReflects) {
                                    R"(, {"name": "room", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]})",
                                    R"(, {"center": [0, 0, 0], "radius": 50, "material": "room"})");
   const AovSums sums = render_aovs(scene, aov_options(Backend::Cpu));
-  const AovImage albedo = aov_image(AovKind::Albedo, sums.sums, sums.samples);
-  const AovImage normal = aov_image(AovKind::Normal, sums.sums, sums.samples);
-  const AovImage depth = aov_image(AovKind::Depth, sums.sums, sums.samples);
+  const AovImage albedo = aov_image(AovKind::Albedo, sums);
+  const AovImage normal = aov_image(AovKind::Normal, sums);
+  const AovImage depth = aov_image(AovKind::Depth, sums);
   const int mid = kSize / 2;
   for (float v : at(albedo, mid, mid)) EXPECT_NEAR(v, 0.4f, 1e-5f);
   for (float v : at(albedo, 0, 0)) EXPECT_NEAR(v, 0.5f, 1e-6f);
@@ -118,7 +118,7 @@ TEST(Aovs, SmoothGlassShowsWhatLiesBehindIt) {
                                    R"(, {"name": "room", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]})",
                                    R"(, {"center": [0, 0, 0], "radius": 50, "material": "room"})");
   const AovSums sums = render_aovs(scene, aov_options(Backend::Cpu, 64));
-  const AovImage albedo = aov_image(AovKind::Albedo, sums.sums, sums.samples);
+  const AovImage albedo = aov_image(AovKind::Albedo, sums);
   const int mid = kSize / 2;
   for (float v : at(albedo, mid, mid)) EXPECT_NEAR(v, 0.5f, 1e-5f);
 }
@@ -143,6 +143,34 @@ TEST(Aovs, CudaSumsTheCpusFirstSurfaces) {
   // A sample whose rounding sends a path the other way at an edge changes one
   // pixel's sums: at most one pixel in a thousand.
   EXPECT_LE(differ, cpu.sums.size() / 1000) << "worst relative difference " << worst;
+}
+
+// After an adaptive render the pass takes each pixel's own samples: a pixel's
+// depth and position are over as many hits as it took samples where every sample
+// hits, and the means divide by each pixel's count. On CUDA, the CPU's sums.
+TEST(Aovs, AnAdaptiveRendersPassTakesEachPixelsSamples) {
+  const Scene scene = sphere_scene(R"({"name": "m", "type": "lambertian", "albedo": [0.3, 0.5, 0.7]})",
+                                   R"(, {"name": "room", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]})",
+                                   R"(, {"center": [0, 0, 0], "radius": 50, "material": "room"})");
+  std::vector<int32_t> counts(kSize * kSize);
+  for (size_t p = 0; p < counts.size(); ++p) counts[p] = 1 + static_cast<int32_t>(p % 7);
+  const RenderOptions o = aov_options(Backend::Cpu, 8);
+  const AovSums sums = render_aovs(scene, o, &counts);
+  ASSERT_EQ(sums.pixel_samples, counts);
+  for (size_t p = 0; p < counts.size(); ++p) {
+    ASSERT_EQ(sums.sums[p * kAovFloats + kAovHits], static_cast<float>(counts[p])) << p;
+  }
+  const int mid = kSize / 2;
+  for (float v : at(aov_image(AovKind::Albedo, sums), mid, mid)) EXPECT_GT(v, 0.29f);  // a mean, not a sum over 8
+  EXPECT_NEAR(at(aov_image(AovKind::Albedo, sums), mid, mid)[0], 0.3f, 1e-6f);
+  if (!test::cuda_available()) GTEST_SKIP() << "the CPU's pass checked; no CUDA device";
+  RenderOptions g = o;
+  g.backend = Backend::Cuda;
+  const AovSums gpu = render_aovs(scene, g, &counts);
+  ASSERT_EQ(gpu.sums.size(), sums.sums.size());
+  for (size_t p = 0; p < counts.size(); ++p) {
+    ASSERT_EQ(gpu.sums[p * kAovFloats + kAovHits], static_cast<float>(counts[p])) << p;
+  }
 }
 
 TEST(Aovs, TheListNamesKnownAovsOnce) {

@@ -423,8 +423,8 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   std::vector<float> denoised;
   if (job.denoise) {
     // Guided by the albedo and the normal of the first-surface pass.
-    const std::vector<float> albedo = denoise_albedo(out.aovs.sums, out.aovs.samples);
-    const std::vector<float> normal = denoise_normal(out.aovs.sums, out.aovs.samples);
+    const std::vector<float> albedo = denoise_albedo(out.aovs);
+    const std::vector<float> normal = denoise_normal(out.aovs);
     const auto start = std::chrono::steady_clock::now();
     DenoiseDevice device = options.backend == Backend::Cuda ? DenoiseDevice::Cuda : DenoiseDevice::Cpu;
     const DenoiseQuality quality = job.denoise_quality == "balanced" ? DenoiseQuality::Balanced : DenoiseQuality::High;
@@ -446,7 +446,7 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   std::vector<AovImage> aovs;
   if (!job.aov.empty()) {
     for (AovKind k : parse_aovs(job.aov)) {
-      aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs.sums, out.aovs.samples)
+      aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs)
                                            : result_aov_image(k, out.result));
     }
   }
@@ -523,7 +523,10 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     if (!job.aov.empty()) {
       for (AovKind k : parse_aovs(job.aov)) first_surface = first_surface || from_first_surface(k);
     }
-    if (first_surface) out.aovs = render_aovs(*scene, options);
+    // An adaptive render's pass takes each pixel's own samples.
+    if (first_surface) {
+      out.aovs = render_aovs(*scene, options, out.result.pixel_samples.empty() ? nullptr : &out.result.pixel_samples);
+    }
     write_job(job, options, out, job_start);
   });
   return out;

@@ -120,7 +120,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   return out;
 }
 
-AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
+                        const std::vector<int32_t>* pixel_samples) {
   const RenderParams& rp = options.params;
   std::vector<ImageView> images;
   const SceneView view = host_view(scene, rp.width, rp.height, images);
@@ -132,7 +133,8 @@ AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
   parallel_for(pixels, rp.width, thread_count(options.threads), [&](int64_t begin, int64_t end, int) {
     for (int64_t px = begin; px < end; ++px) {
       float* sums = out.sums.data() + px * kAovFloats;
-      for (int32_t s = 0; s < rp.spp; ++s) {
+      const int32_t samples = pixel_samples ? (*pixel_samples)[px] : rp.spp;
+      for (int32_t s = 0; s < samples; ++s) {
         add_first_surface(sums, first_surface(view, rp, static_cast<uint32_t>(px), static_cast<uint32_t>(s)));
       }
     }

@@ -21,6 +21,7 @@ DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options,
 
 // The first-surface pass (include/wavetrace/aov.hpp) over every sample of every
 // pixel, on host threads: the sums the AOVs are made of.
-AovSums render_aov_sums(const Scene& scene, const RenderOptions& options);
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
+                        const std::vector<int32_t>* pixel_samples = nullptr);
 
 }  // namespace wt::cpu

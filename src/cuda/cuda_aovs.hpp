@@ -7,7 +7,9 @@
 
 namespace wt::cuda {
 
-// Writes every pixel's kAovFloats sums over samples [0, rp.spp) to `sums`.
-void launch_first_surface(const SceneView& scene, const RenderParams& rp, float* sums, cudaStream_t stream);
+// Writes every pixel's kAovFloats sums over samples [0, rp.spp), or [0, counts[p])
+// of pixel p where `counts` is given, to `sums`.
+void launch_first_surface(const SceneView& scene, const RenderParams& rp, const int32_t* counts, float* sums,
+                          cudaStream_t stream);
 
 }  // namespace wt::cuda

@@ -244,7 +244,8 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   return out;
 }
 
-AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
+                        const std::vector<int32_t>* pixel_samples) {
   constexpr const char* kAovStage = "aovs";
   if (!options.devices.empty()) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
   const RenderParams& rp = options.params;
@@ -253,11 +254,13 @@ AovSums render_aov_sums(const Scene& scene, const RenderOptions& options) {
   require_device_memory(rp, floats * sizeof(float) + scene.device_bytes(), info.free_memory, info.name);
   const DeviceScene ds(scene, rp.width, rp.height);
   DeviceBuffer<float> sums(floats, kAovStage);
+  DeviceBuffer<int32_t> counts(pixel_samples ? pixel_samples->size() : 0, kAovStage);
+  if (pixel_samples) counts.upload(*pixel_samples, kAovStage);
   AovSums out;
   out.samples = rp.spp;
   EventTimer timer(kAovStage);
   timer.start();
-  launch_first_surface(ds.view(), rp, sums.get(), nullptr);
+  launch_first_surface(ds.view(), rp, pixel_samples ? counts.get() : nullptr, sums.get(), nullptr);
   out.seconds = timer.stop();
   out.sums = sums.download(kAovStage);
   return out;

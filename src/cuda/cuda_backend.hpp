@@ -26,7 +26,8 @@ DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options,
 // The first-surface pass (include/wavetrace/aov.hpp) on the first of
 // options.devices (or the current device), over a scene uploaded for it: the sums
 // the AOVs are made of.
-AovSums render_aov_sums(const Scene& scene, const RenderOptions& options);
+AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
+                        const std::vector<int32_t>* pixel_samples = nullptr);
 
 // Device bytes a render with these settings needs beyond the scene itself.
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size);

@@ -107,11 +107,21 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options) {
   return render_on_backend(scene, options);
 }
 
-AovSums render_aovs(const Scene& scene, const RenderOptions& options) {
+AovSums render_aovs(const Scene& scene, const RenderOptions& options, const std::vector<int32_t>* pixel_samples) {
   validate_params(options.params);
-  if (options.backend == Backend::Cpu) return cpu::render_aov_sums(scene, options);
-  cuda::check_devices(options);
-  return cuda::render_aov_sums(scene, options);
+  const size_t pixels = static_cast<size_t>(options.params.width) * options.params.height;
+  if (pixel_samples && pixel_samples->size() != pixels) {
+    throw std::logic_error("render_aovs: a count of samples for each pixel, or none");
+  }
+  AovSums out;
+  if (options.backend == Backend::Cpu) {
+    out = cpu::render_aov_sums(scene, options, pixel_samples);
+  } else {
+    cuda::check_devices(options);
+    out = cuda::render_aov_sums(scene, options, pixel_samples);
+  }
+  if (pixel_samples) out.pixel_samples = *pixel_samples;
+  return out;
 }
 
 void take_mean(RenderResult& r) {

@@ -25,7 +25,9 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options);
 // The first-surface pass that the AOVs are made of (render/aovs.hpp), over every
 // sample of every pixel, on the options' backend (the first of its devices): the same
 // for every kernel, since the pass follows the camera's rays and not a kernel's queues.
-AovSums render_aovs(const Scene& scene, const RenderOptions& options);
+// With `pixel_samples` (an adaptive render's), pixel p's samples [0, pixel_samples[p]).
+AovSums render_aovs(const Scene& scene, const RenderOptions& options,
+                    const std::vector<int32_t>* pixel_samples = nullptr);
 
 // Turns a backend's pixel sums over r.samples samples into means (every render's
 // last step; also for a film that was complete when it was resumed).

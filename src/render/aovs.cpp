@@ -47,13 +47,14 @@ namespace {
 
 // Channels [first, first + n) of each pixel's sums, divided by `over` (the samples,
 // or the pixel's hits); `missing` where that is 0.
-std::vector<float> means(const std::vector<float>& sums, int first, int n, int32_t samples, bool over_hits,
-                         float missing, float lo = -std::numeric_limits<float>::infinity(),
+std::vector<float> means(const AovSums& a, int first, int n, bool over_hits, float missing,
+                         float lo = -std::numeric_limits<float>::infinity(),
                          float hi = std::numeric_limits<float>::infinity()) {
-  const size_t pixels = sums.size() / kAovFloats;
+  const size_t pixels = a.sums.size() / kAovFloats;
   std::vector<float> out(pixels * n);
   for (size_t p = 0; p < pixels; ++p) {
-    const float* s = sums.data() + p * kAovFloats;
+    const float* s = a.sums.data() + p * kAovFloats;
+    const int32_t samples = a.pixel_samples.empty() ? a.samples : a.pixel_samples[p];
     const float count = over_hits ? s[kAovHits] : static_cast<float>(samples);
     for (int c = 0; c < n; ++c) {
       out[p * n + c] = count > 0.0f ? std::clamp(s[first + c] / count, lo, hi) : missing;
@@ -64,24 +65,24 @@ std::vector<float> means(const std::vector<float>& sums, int first, int n, int32
 
 }  // namespace
 
-AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples) {
+AovImage aov_image(AovKind kind, const AovSums& sums) {
   AovImage image{kind, aov_name(kind), {}, {}};
   switch (kind) {
     case AovKind::Albedo:
       image.channels = {"R", "G", "B"};
-      image.values = means(sums, kAovAlbedo, 3, samples, false, 0.0f);
+      image.values = means(sums, kAovAlbedo, 3, false, 0.0f);
       break;
     case AovKind::Normal:
       image.channels = {"X", "Y", "Z"};
-      image.values = means(sums, kAovNormal, 3, samples, false, 0.0f);
+      image.values = means(sums, kAovNormal, 3, false, 0.0f);
       break;
     case AovKind::Depth:
       image.channels = {"Z"};
-      image.values = means(sums, kAovDepth, 1, samples, true, std::numeric_limits<float>::infinity());
+      image.values = means(sums, kAovDepth, 1, true, std::numeric_limits<float>::infinity());
       break;
     case AovKind::Position:
       image.channels = {"X", "Y", "Z"};
-      image.values = means(sums, kAovPosition, 3, samples, true, 0.0f);
+      image.values = means(sums, kAovPosition, 3, true, 0.0f);
       break;
     case AovKind::Variance:
     case AovKind::Spp:
@@ -108,12 +109,12 @@ AovImage result_aov_image(AovKind kind, const RenderResult& result) {
   return image;
 }
 
-std::vector<float> denoise_albedo(const std::vector<float>& sums, int32_t samples) {
-  return means(sums, kAovAlbedo, 3, samples, false, 0.0f, 0.0f, 1.0f);
+std::vector<float> denoise_albedo(const AovSums& sums) {
+  return means(sums, kAovAlbedo, 3, false, 0.0f, 0.0f, 1.0f);
 }
 
-std::vector<float> denoise_normal(const std::vector<float>& sums, int32_t samples) {
-  return means(sums, kAovNormal, 3, samples, false, 0.0f, -1.0f, 1.0f);
+std::vector<float> denoise_normal(const AovSums& sums) {
+  return means(sums, kAovNormal, 3, false, 0.0f, -1.0f, 1.0f);
 }
 
 }  // namespace wt

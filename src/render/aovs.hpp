@@ -24,10 +24,12 @@ const char* aov_name(AovKind kind);
 std::vector<AovKind> parse_aovs(const std::string& list, const std::string& field = "--aov");
 
 // The first-surface pass's sums (kAovFloats floats a pixel, include/wavetrace/aov.hpp)
-// over samples [0, samples) of every pixel, as a backend returns them.
+// over samples [0, samples) of every pixel, or [0, pixel_samples[p]) of pixel p where
+// the pass followed an adaptive render's counts, as a backend returns them.
 struct AovSums {
   std::vector<float> sums;
   int32_t samples = 0;
+  std::vector<int32_t> pixel_samples;  // empty: `samples` for every pixel
   double seconds = 0;  // the pass alone (CUDA events on the GPU, wall clock on the CPU)
 };
 
@@ -47,14 +49,14 @@ bool from_first_surface(AovKind kind);
 // samples a pixel (kAovFloats a pixel): albedo and normal are means over every
 // sample; depth and position means over the samples that hit a surface, a pixel none
 // of whose samples did holding an infinite depth and a zero position.
-AovImage aov_image(AovKind kind, const std::vector<float>& sums, int32_t samples);
+AovImage aov_image(AovKind kind, const AovSums& sums);
 // The AOV `kind` (variance or spp) of the render's result: the variance of each
 // pixel's mean (R, G, B; render/adaptive.hpp), its samples (Y).
 AovImage result_aov_image(AovKind kind, const RenderResult& result);
 
 // The albedo and normal as OIDN takes them: the albedo's mean clamped to [0, 1], the
 // normal's mean.
-std::vector<float> denoise_albedo(const std::vector<float>& sums, int32_t samples);
-std::vector<float> denoise_normal(const std::vector<float>& sums, int32_t samples);
+std::vector<float> denoise_albedo(const AovSums& sums);
+std::vector<float> denoise_normal(const AovSums& sums);
 
 }  // namespace wt
