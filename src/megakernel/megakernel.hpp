@@ -22,6 +22,12 @@ struct MegakernelWork {
   float* radiance;
   const uint32_t* active = nullptr;
   uint32_t count = 0;  // with active
+
+  // The pixels the launch covers, and the one at `index` of them.
+  WT_HD uint32_t pixels(const RenderParams& rp) const {
+    return active ? count : static_cast<uint32_t>(rp.width) * static_cast<uint32_t>(rp.height);
+  }
+  WT_HD uint32_t pixel(uint32_t index) const { return active ? active[index] : index; }
 };
 
 // A small image fills the GPU with too few threads at one a pixel (at 512 x 384 an

@@ -25,10 +25,10 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
   const int z = static_cast<int>(blockIdx.z);
   // The thread's place in the work's pixels, and its pixel.
   const uint32_t index = static_cast<uint32_t>(y) * rp.width + x;
-  const uint32_t pixels = out.active ? out.count : static_cast<uint32_t>(rp.width) * rp.height;
+  const uint32_t pixels = out.pixels(rp);
   uint32_t count = 0, shadow_count = 0;
   if (x < rp.width && index < pixels && (!out.radiance || z < samples)) {
-    const uint32_t pixel = out.active ? out.active[index] : index;
+    const uint32_t pixel = out.pixel(index);
     // One call of trace_path in the kernel, whichever way: it is most of its code.
     const int begin = out.radiance ? first_sample + z : first_sample;
     const int end = out.radiance ? begin + 1 : first_sample + samples;
@@ -66,7 +66,7 @@ __device__ __forceinline__ void megakernel_pixel(const Scene& scene, const Rende
 // read a row of the image's width at a time), `batch` deep where the samples are a
 // batch (one thread a pixel and sample), else one deep.
 inline dim3 megakernel_grid(const RenderParams& rp, int batch, const MegakernelWork& work) {
-  const uint32_t rows = work.active ? (work.count + rp.width - 1) / rp.width : static_cast<uint32_t>(rp.height);
+  const uint32_t rows = (work.pixels(rp) + rp.width - 1) / rp.width;
   return dim3((rp.width + kMegakernelBlockX - 1) / kMegakernelBlockX,
               std::max<uint32_t>(1, (rows + kMegakernelBlockY - 1) / kMegakernelBlockY), static_cast<unsigned>(batch));
 }

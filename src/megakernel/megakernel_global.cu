@@ -18,10 +18,10 @@ __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
 // adds the sum to the film, the others keep it in `running`.
 __global__ void megakernel_fold(RenderParams rp, int samples, MegakernelWork work, float* running, bool first,
                                 bool last) {
-  const size_t pixels = work.active ? work.count : static_cast<size_t>(rp.width) * rp.height;
+  const size_t pixels = work.pixels(rp);
   const size_t index = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (index >= pixels) return;
-  const size_t pixel = work.active ? work.active[index] : index;
+  const size_t pixel = work.pixel(static_cast<uint32_t>(index));
   vec3 sum = first ? vec3(0.0f) : vec3(running[3 * index], running[3 * index + 1], running[3 * index + 2]);
   for (int j = 0; j < samples; ++j) {
     const float* r = work.radiance + 3 * (j * pixels + index);
@@ -47,7 +47,7 @@ int megakernel_batch(int64_t pixels, int sm_count, int pass_samples) {
 
 void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork work, float* running, bool first,
                             bool last, cudaStream_t stream) {
-  const size_t pixels = work.active ? work.count : static_cast<size_t>(rp.width) * rp.height;
+  const size_t pixels = work.pixels(rp);
   constexpr unsigned kBlock = 256;
   megakernel_fold<<<static_cast<unsigned>((pixels + kBlock - 1) / kBlock), kBlock, 0, stream>>>(
       rp, samples, work, running, first, last);
