@@ -6,28 +6,31 @@
 
 namespace wt {
 
+namespace {
+
+// V of one quantity from its halves' means (the header's formula); both halves hold
+// samples.
+double variance_of_mean(double mean_a, double mean_b, int32_t n_a, int32_t n_b) {
+  const double n = static_cast<double>(n_a) + n_b;
+  const double d = mean_a - mean_b;
+  return d * d * (static_cast<double>(n_a) * n_b) / (n * n);
+}
+
+}  // namespace
+
 void mean_variance(const PixelHalves& h, double v[3]) {
-  const double n = static_cast<double>(h.n_a) + h.n_b;
   for (int c = 0; c < 3; ++c) {
-    if (h.n_a == 0 || h.n_b == 0) {
-      v[c] = 0.0;
-      continue;
-    }
-    const double d = h.a[c] / h.n_a - h.b[c] / h.n_b;
-    v[c] = d * d * (static_cast<double>(h.n_a) * h.n_b) / (n * n);
+    v[c] = h.n_a == 0 || h.n_b == 0 ? 0.0 : variance_of_mean(h.a[c] / h.n_a, h.b[c] / h.n_b, h.n_a, h.n_b);
   }
 }
 
 double relative_error_squared(const PixelHalves& h) {
   if (h.n_a == 0 || h.n_b == 0) return 0.0;
-  const double n = static_cast<double>(h.n_a) + h.n_b;
   const double ya = luminance(h.a[0], h.a[1], h.a[2]) / h.n_a;
   const double yb = luminance(h.b[0], h.b[1], h.b[2]) / h.n_b;
-  const double y = (ya * h.n_a + yb * h.n_b) / n;
-  const double d = ya - yb;
-  const double v = d * d * (static_cast<double>(h.n_a) * h.n_b) / (n * n);
+  const double y = (ya * h.n_a + yb * h.n_b) / (static_cast<double>(h.n_a) + h.n_b);
   const double scale = std::max(y, kNoiseFloor);
-  return v / (scale * scale);
+  return variance_of_mean(ya, yb, h.n_a, h.n_b) / (scale * scale);
 }
 
 std::vector<uint8_t> converged_pixels(const std::vector<double>& r2, int width, int height, double threshold) {
@@ -71,6 +74,12 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
   std::vector<float> half_a(pixels * 3, 0.0f), half_b(pixels * 3, 0.0f);
   std::vector<int32_t> n_a(pixels, 0), n_b(pixels, 0);
   std::vector<uint8_t> done(pixels, 0);
+  auto halves_of = [&](size_t p) {
+    return PixelHalves{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
+                       {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
+                       n_a[p],
+                       n_b[p]};
+  };
   std::vector<uint32_t> active(pixels);
   for (size_t p = 0; p < pixels; ++p) active[p] = static_cast<uint32_t>(p);
 
@@ -125,13 +134,7 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
     round(b, false);
     // Which pixels go on: those whose neighbourhood is still above the threshold.
     std::vector<double> r2(pixels, 0.0);
-    for (size_t p = 0; p < pixels; ++p) {
-      const PixelHalves h{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
-                          {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
-                          n_a[p],
-                          n_b[p]};
-      r2[p] = relative_error_squared(h);
-    }
+    for (size_t p = 0; p < pixels; ++p) r2[p] = relative_error_squared(halves_of(p));
     const std::vector<uint8_t> now = converged_pixels(r2, rp.width, rp.height, threshold);
     std::vector<uint32_t> going;
     for (uint32_t p : active) {
@@ -150,12 +153,8 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
   for (size_t p = 0; p < pixels; ++p) {
     const int32_t count = n_a[p] + n_b[p];
     out.pixel_samples[p] = count;
-    const PixelHalves h{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
-                        {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
-                        n_a[p],
-                        n_b[p]};
     double v[3];
-    mean_variance(h, v);
+    mean_variance(halves_of(p), v);
     for (int c = 0; c < 3; ++c) {
       out.rgb[3 * p + c] = count > 0 ? static_cast<float>((half_a[3 * p + c] + half_b[3 * p + c]) / count) : 0.0f;
       out.variance[3 * p + c] = static_cast<float>(v[c]);
@@ -165,6 +164,13 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
   out.samples = n;
   out.radiance = Radiance::MeanOfSamples;
   return out;
+}
+
+double mean_spp(const RenderResult& r) {
+  if (r.pixel_samples.empty()) return 0.0;
+  uint64_t samples = 0;
+  for (int32_t n : r.pixel_samples) samples += static_cast<uint64_t>(n);
+  return static_cast<double>(samples) / r.pixel_samples.size();
 }
 
 }  // namespace wt

@@ -69,4 +69,7 @@ int32_t step_samples(int32_t n, int32_t min_spp, int32_t spp);
 RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& options, double threshold,
                              int32_t min_spp);
 
+// The mean of an adaptive result's pixel_samples (0 where it has none).
+double mean_spp(const RenderResult& r);
+
 }  // namespace wt
