@@ -21,6 +21,7 @@
 #include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "image/denoise.hpp"
+#include "render/adaptive.hpp"
 
 namespace wt::app {
 
@@ -212,10 +213,7 @@ void check_outputs(const Job& job, bool distributed) {
     std::snprintf(got, sizeof got, "%g", *job.noise_threshold);
     throw InputError(std::string("--noise-threshold: must be above 0 (got ") + got + ")");
   }
-  bool variance = false;
-  if (!job.aov.empty()) {
-    for (AovKind k : parse_aovs(job.aov)) variance = variance || k == AovKind::Variance;
-  }
+  const bool variance = job_asks_for(job, AovKind::Variance);
   if (job.noise_threshold || variance) {
     const char* what = job.noise_threshold ? "--noise-threshold" : "--aov variance";
     if (!checkpoint_of(job).empty()) {
@@ -262,11 +260,7 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.min_spp = static_cast<int32_t>(job.min_spp);
   // The variance AOV is the adaptive rounds' estimate: without a threshold, the same
   // rounds with no pixel stopping.
-  if (options.noise_threshold == 0 && !job.aov.empty()) {
-    for (AovKind k : parse_aovs(job.aov)) {
-      if (k == AovKind::Variance) options.noise_threshold = -1;
-    }
-  }
+  if (options.noise_threshold == 0 && job_asks_for(job, AovKind::Variance)) options.noise_threshold = -1;
   options.threads = static_cast<int>(job.threads);
   options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
   return options;
@@ -444,11 +438,8 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   const auto write_start = std::chrono::steady_clock::now();
   // The AOVs: layers of an OpenEXR output, else files of their own beside it.
   std::vector<AovImage> aovs;
-  if (!job.aov.empty()) {
-    for (AovKind k : parse_aovs(job.aov)) {
-      aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs)
-                                           : result_aov_image(k, out.result));
-    }
+  for (AovKind k : job_aovs(job)) {
+    aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs) : result_aov_image(k, out.result));
   }
   const std::vector<JobFile> aov_files = aov_outputs(job);
   std::vector<ImageLayer> layers;
@@ -520,9 +511,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
     // The AOVs and the denoiser's guides: one first-surface pass over the whole
     // render's samples, whatever kernel, checkpoint or ranks made the image.
     bool first_surface = job.denoise;
-    if (!job.aov.empty()) {
-      for (AovKind k : parse_aovs(job.aov)) first_surface = first_surface || from_first_surface(k);
-    }
+    for (AovKind k : job_aovs(job)) first_surface = first_surface || from_first_surface(k);
     // An adaptive render's pass takes each pixel's own samples.
     if (first_surface) {
       out.aovs = render_aovs(*scene, options, out.result.pixel_samples.empty() ? nullptr : &out.result.pixel_samples);
@@ -549,8 +538,8 @@ void print_outcome(const Job& job, const JobOutcome& o) {
   const double pixels = static_cast<double>(o.params.width) * o.params.height;
   if (job.noise_threshold && pixels > 0) {
     std::fprintf(stderr, "  adaptive: %llu of %.0f pixels converged under %g; %.1f spp on average, %d at most\n",
-                 static_cast<unsigned long long>(r.converged), pixels, *job.noise_threshold,
-                 static_cast<double>(r.paths) / pixels, r.samples);
+                 static_cast<unsigned long long>(r.converged), pixels, *job.noise_threshold, mean_spp(r),
+                 r.samples);
   }
   for (const DeviceShare& s : r.shares) {
     // Chunks of samples, or (a wavefront's devices sharing the paths) blocks of paths.

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -45,10 +46,19 @@ std::string noisy_output(const Job& job) {
   return (p.parent_path() / (p.stem().string() + ".noisy" + p.extension().string())).string();
 }
 
+std::vector<AovKind> job_aovs(const Job& job) {
+  return job.aov.empty() ? std::vector<AovKind>{} : parse_aovs(job.aov);
+}
+
+bool job_asks_for(const Job& job, AovKind kind) {
+  const std::vector<AovKind> kinds = job_aovs(job);
+  return std::find(kinds.begin(), kinds.end(), kind) != kinds.end();
+}
+
 std::vector<JobFile> aov_outputs(const Job& job) {
   std::vector<JobFile> files;
-  if (job.aov.empty() || job.output.empty()) return files;
-  const std::vector<AovKind> kinds = parse_aovs(job.aov);
+  if (job.output.empty()) return files;
+  const std::vector<AovKind> kinds = job_aovs(job);
   const std::filesystem::path p(job.output);
   if (p.extension() == ".exr") return files;
   for (AovKind k : kinds) {

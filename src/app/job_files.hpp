@@ -28,6 +28,11 @@ std::vector<JobFile> job_files(const Job& job);
 // the output NAME.EXT. Empty where the job keeps none.
 std::string noisy_output(const Job& job);
 
+// The AOVs the job asks for (--aov), in its order; none where it names none. Throws
+// InputError for a list --aov does not take.
+std::vector<AovKind> job_aovs(const Job& job);
+bool job_asks_for(const Job& job, AovKind kind);
+
 // Where each AOV the job asks for goes, as its field ("albedo AOV") and path:
 // NAME.<aov>.pfm beside an output NAME.EXT that is not OpenEXR, whose AOVs are its
 // layers (none here). Throws InputError for a list --aov does not take.

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "app/job_files.hpp"
+#include "render/adaptive.hpp"
 #include "errors/errors.hpp"
 
 namespace wt::app {
@@ -115,12 +116,10 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   if (job.noise_threshold) {
     // Adaptive sampling: its threshold, and how it ended.
     const RenderResult& a = o.result;
-    uint64_t samples = 0;
-    for (int32_t n : a.pixel_samples) samples += static_cast<uint64_t>(n);
     j["adaptive"] = {{"noise_threshold", *job.noise_threshold},
                      {"converged_pixels", a.converged},
                      {"pixels", a.pixel_samples.size()},
-                     {"mean_spp", a.pixel_samples.empty() ? 0.0 : static_cast<double>(samples) / a.pixel_samples.size()},
+                     {"mean_spp", mean_spp(a)},
                      {"max_spp", a.samples}};
   }
   j["backend"] = o.backend;
@@ -143,9 +142,7 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   if (!job.aov.empty() || job.denoise) {
     // The first-surface pass: the AOVs asked for and the denoiser's guides.
     nlohmann::json aovs = {{"seconds", o.aovs.seconds}, {"samples", o.aovs.samples}, {"names", nlohmann::json::array()}};
-    if (!job.aov.empty()) {
-      for (AovKind k : parse_aovs(job.aov)) aovs["names"].push_back(aov_name(k));
-    }
+    for (AovKind k : job_aovs(job)) aovs["names"].push_back(aov_name(k));
     const std::vector<JobFile> files = aov_outputs(job);
     if (!files.empty()) {
       aovs["files"] = nlohmann::json::array();
