@@ -10,6 +10,13 @@ namespace wt::app {
 
 void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
   for (const Setting& s : settings()) {
+    if (s.type == SettingType::Real) {
+      // The one real setting, the noise threshold: above its lower bound, which
+      // CLI::Range (inclusive) cannot say, so the job's check says it.
+      cmd.add_option_function<double>(
+          s.flag, [&job](double v) { job.noise_threshold = v; }, s.help);
+      continue;
+    }
     cmd.add_option_function<int64_t>(
            s.flag, [&job, id = s.id](int64_t v) { set_setting(job, id, v); }, s.help)
         ->check(CLI::Range(s.lo, s.hi));
@@ -32,9 +39,6 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
   cmd.add_option("--denoise-quality", job.denoise_quality, "the denoiser's quality: high (default) or balanced")
       ->check(CLI::IsMember(denoise_quality_choices()));
   cmd.add_flag("--keep-noisy", job.keep_noisy, "with --denoise: write the render itself too, as NAME.noisy.EXT");
-  cmd.add_option("--noise-threshold", job.noise_threshold,
-                 "adaptive sampling: each pixel stops once its neighbourhood's relative error is at most this "
-                 "(e.g. 0.01), after --min-spp samples and at most --spp");
   cmd.add_option("--aov", job.aov,
                  "write these AOVs too, comma-separated: " + listed(aov_names()) +
                      " (layers of an .exr output, else NAME.<aov>.pfm beside it)");
@@ -93,7 +97,7 @@ std::vector<std::string> render_arguments(const Job& job) {
   if (job.noise_threshold) {
     char t[40];
     std::snprintf(t, sizeof t, "%.17g", *job.noise_threshold);
-    add("--noise-threshold", t);
+    add(setting(SettingId::NoiseThreshold).flag, t);
   }
   if (!job.progress) args.push_back("--quiet");
   if (job.profile) args.push_back("--profile");

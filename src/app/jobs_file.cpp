@@ -25,7 +25,7 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k = {"scene",    "output",    "stats",    "checkpoint",      "resume",    "backend",
-                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy", "aov", "noise_threshold"};
+                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy", "aov"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -63,9 +63,6 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.denoise_quality = denoise_quality_choices()[r.choice(value, at, denoise_quality_choices())];
     } else if (key == "keep_noisy") {
       job.keep_noisy = r.boolean(value, at);
-    } else if (key == "noise_threshold") {
-      if (!value.is_number() || !(value.get<double>() > 0)) r.fail_at(at, "must be a number above 0");
-      job.noise_threshold = value.get<double>();
     } else if (key == "aov") {
       job.aov = r.string(value, at);
       try {
@@ -75,7 +72,12 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       }
     } else {
       for (const Setting& s : settings()) {
-        if (key == s.key) set_setting(job, s.id, r.integer(value, at, s.lo, s.hi));
+        if (key != s.key) continue;
+        if (s.type == SettingType::Real) {
+          job.noise_threshold = r.real_setting(value, at, s.id);
+        } else {
+          set_setting(job, s.id, r.integer_setting(value, at, s.id));
+        }
       }
     }
   }

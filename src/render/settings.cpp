@@ -1,5 +1,7 @@
 #include "render/settings.hpp"
 
+#include <cstdio>
+
 #include "errors/errors.hpp"
 #include "queues/wave.hpp"
 
@@ -29,6 +31,10 @@ const std::vector<Setting>& settings() {
        "image's size and the device's; 1: one thread a pixel); the image is the same"},
       {SettingId::MinSpp, "min_spp", "--min-spp", SettingType::Int32, 0, kMaxSpp, 0,
        "with --noise-threshold: the samples every pixel takes first (default 0: 16, or spp where less)"},
+      {SettingId::NoiseThreshold, "noise_threshold", "--noise-threshold", SettingType::Real, 0, 0, 0,
+       "adaptive sampling: each pixel stops once its neighbourhood's relative error is at most this (e.g. 0.01), "
+       "after --min-spp samples and at most --spp",
+       0.0, 1.0},
   };
   return table;
 }
@@ -74,6 +80,26 @@ void check_setting(SettingId id, int64_t value) {
     throw InputError(std::string(s.key) + ": must be in " + std::to_string(s.lo) + ".." + std::to_string(s.hi) +
                      " (got " + std::to_string(value) + ")");
   }
+}
+
+void check_real_setting(SettingId id, double value) {
+  const Setting& s = setting(id);
+  if (!(value > s.real_above && value <= s.real_most)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%s: must be above %g and at most %g (got %g)", s.key, s.real_above, s.real_most,
+                  value);
+    throw InputError(text);
+  }
+}
+
+const std::vector<SettingId>& scene_settings() {
+  static const std::vector<SettingId> ids = [] {
+    std::vector<SettingId> v = render_settings();
+    v.push_back(SettingId::MinSpp);
+    v.push_back(SettingId::NoiseThreshold);
+    return v;
+  }();
+  return ids;
 }
 
 namespace {

@@ -27,6 +27,10 @@ constexpr int kMaxRouletteDepth = 1 << 30;
 // section says otherwise.
 struct RenderDefaults : RenderParams {
   RenderDefaults() : RenderParams{640, 360, 16, 10, 5, 1} {}
+  // Adaptive sampling (render/adaptive.hpp), which a scene's `render` section may ask
+  // for too: a threshold above 0 turns it on; min_spp 0 chooses.
+  double noise_threshold = 0;
+  int32_t min_spp = 0;
 };
 
 enum class SettingId {
@@ -42,10 +46,13 @@ enum class SettingId {
   Threads,
   CheckpointEvery,
   MegakernelBatch,
-  MinSpp
+  MinSpp,
+  NoiseThreshold
 };
 
-enum class SettingType { Int32, UInt32, Int64 };
+// Real: a number, in (real_above, real_most] (the one setting of this type, the noise
+// threshold, has no default: unset, it is off).
+enum class SettingType { Int32, UInt32, Int64, Real };
 
 struct Setting {
   SettingId id;
@@ -55,6 +62,7 @@ struct Setting {
   int64_t lo, hi;    // the inclusive range of a value that is given
   int64_t fallback;  // the default; 0 for wave_size and threads: chosen at run time
   const char* help;
+  double real_above = 0, real_most = 0;  // a Real setting's range (lo, hi are an integer's)
 };
 
 // Every setting, in the order above.
@@ -69,6 +77,11 @@ void set_param(RenderParams& p, SettingId id, int64_t value);
 
 // Throws InputError "<key>: must be in lo..hi (got value)" when value is out of range.
 void check_setting(SettingId id, int64_t value);
+// Of a Real setting: "<key>: must be above A and at most B (got value)".
+void check_real_setting(SettingId id, double value);
+// The settings a scene's `render` section takes: render_settings(), and adaptive
+// sampling's (min_spp, noise_threshold), which RenderDefaults holds beside them.
+const std::vector<SettingId>& scene_settings();
 
 // The kernels, in the order the docs and plots list them, their names, and the
 // backends each runs on.

@@ -246,6 +246,24 @@ double JsonReader::real(const json& j, const JsonPath& path, double lo, double h
   return v;
 }
 
+int64_t JsonReader::integer_setting(const json& j, const JsonPath& path, SettingId id) const {
+  const Setting& s = setting(id);
+  return integer(j, path, s.lo, s.hi);
+}
+
+double JsonReader::real_setting(const json& j, const JsonPath& path, SettingId id) const {
+  const Setting& s = setting(id);
+  if (!j.is_number()) fail_at(path, std::string("must be a number (got ") + j.type_name() + ")");
+  const double v = j.get<double>();
+  try {
+    check_real_setting(id, v);
+  } catch (const InputError& e) {
+    // "<key>: must be ...", said of the field instead.
+    fail_at(path, std::string(e.what()).substr(std::strlen(s.key) + 2));
+  }
+  return v;
+}
+
 int64_t JsonReader::integer(const json& j, const JsonPath& path, int64_t lo, int64_t hi) const {
   auto range = [&] { return "must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi); };
   if (!j.is_number()) fail_at(path, range() + " (got " + j.type_name() + ")");

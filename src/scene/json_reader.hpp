@@ -77,6 +77,10 @@ class JsonReader {
   double real(const json& j, const JsonPath& path, double lo, double hi) const;
   // An integer in lo..hi; integral floats (2.0, 1e3) count as integers.
   int64_t integer(const json& j, const JsonPath& path, int64_t lo, int64_t hi) const;
+  // A setting of the table (render/settings.hpp) within its range: an integer one's
+  // as integer() reads it, a real one's (the noise threshold) in (real_above, real_most].
+  int64_t integer_setting(const json& j, const JsonPath& path, SettingId id) const;
+  double real_setting(const json& j, const JsonPath& path, SettingId id) const;
 
  private:
   std::string source_;

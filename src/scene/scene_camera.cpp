@@ -140,12 +140,21 @@ void SceneReader::read_sky(const json& j, const JsonPath& path) {
 
 void SceneReader::read_render(const json& j, const JsonPath& path) {
   std::vector<std::string> keys;
-  for (SettingId id : render_settings()) keys.push_back(setting(id).key);
+  for (SettingId id : scene_settings()) keys.push_back(setting(id).key);
   check_keys(j, path, keys);
   for (SettingId id : render_settings()) {
     const Setting& s = setting(id);
     auto it = j.find(s.key);
-    if (it != j.end()) set_param(scene_.render, id, integer(*it, path / s.key, s.lo, s.hi));
+    if (it != j.end()) set_param(scene_.render, id, integer_setting(*it, path / s.key, id));
+  }
+  // Adaptive sampling, asked for by the scene (a job's own settings come first).
+  const char* min_spp = setting(SettingId::MinSpp).key;
+  const char* threshold = setting(SettingId::NoiseThreshold).key;
+  if (j.contains(min_spp)) {
+    scene_.render.min_spp = static_cast<int32_t>(integer_setting(j[min_spp], path / min_spp, SettingId::MinSpp));
+  }
+  if (j.contains(threshold)) {
+    scene_.render.noise_threshold = real_setting(j[threshold], path / threshold, SettingId::NoiseThreshold);
   }
 }
 

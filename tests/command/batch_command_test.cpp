@@ -483,16 +483,16 @@ TEST_F(BatchCommand, AnAdaptiveRenderSaysHowItEnded) {
   EXPECT_TRUE(fs::exists(path("j.spp.pfm")));
 }
 
-// A threshold that is not above 0, min_spp above spp or without a threshold, and an
-// adaptive render with a checkpoint: one line and exit 2, no file.
+// A threshold that is not above 0 or above 1, min_spp above spp or without a
+// threshold (the job's or the scene's): one line and exit 2, no file.
 TEST_F(BatchCommand, AdaptiveSamplingsBadInputIsOneLineAndNoFile) {
   const std::string render = "render '" + path("s.json") + "' -o '" + path("o.png") + "' --backend cpu --width 8 --height 8 --spp 16 -q";
   for (const auto& [args, message] :
-       {std::pair<std::string, std::string>{" --noise-threshold 0", "--noise-threshold: must be above 0 (got 0)"},
-        {" --noise-threshold -0.5", "--noise-threshold: must be above 0 (got -0.5)"},
+       {std::pair<std::string, std::string>{" --noise-threshold 0", "--noise-threshold: must be above 0 and at most 1 (got 0)"},
+        {" --noise-threshold -0.5", "--noise-threshold: must be above 0 and at most 1 (got -0.5)"},
+        {" --noise-threshold 1.5", "--noise-threshold: must be above 0 and at most 1 (got 1.5)"},
         {" --noise-threshold 0.1 --min-spp 32", "--min-spp: 32 is more than the 16 samples per pixel"},
-        {" --min-spp 4", "--min-spp: the samples every pixel takes before adaptive sampling stops any; give --noise-threshold too"},
-        {" --noise-threshold 0.1 --checkpoint '" + path("c.ckpt") + "'", "--noise-threshold: an adaptive render keeps no checkpoint yet"}}) {
+        {" --min-spp 4", "--min-spp: the samples every pixel takes before adaptive sampling stops any; give --noise-threshold too"}}) {
     SCOPED_TRACE(args);
     EXPECT_EQ(wavetrace(render + args), 2) << err_;
     EXPECT_NE(err_.find(message), std::string::npos) << err_;
@@ -502,8 +502,23 @@ TEST_F(BatchCommand, AdaptiveSamplingsBadInputIsOneLineAndNoFile) {
   std::ofstream(path("jobs.json")) << R"({"jobs": [{"scene": "s.json", "output": "j.png", "backend": "cpu",
     "width": 8, "height": 8, "spp": 4, "noise_threshold": 0}]})";
   EXPECT_NE(batch("'" + path("jobs.json") + "'"), 0) << err_;
-  EXPECT_NE(err_.find("/jobs/0/noise_threshold"), std::string::npos) << err_;
+  EXPECT_NE(err_.find("/jobs/0/noise_threshold: must be above 0 and at most 1 (got 0)"), std::string::npos) << err_;
   EXPECT_FALSE(fs::exists(path("j.png")));
+  // A scene's render section: its threshold checked where it is read, its min_spp
+  // wanting a threshold.
+  std::ofstream(path("t.json")) << R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]}, "render": {"noise_threshold": 2},
+    "materials": [{"name": "m", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]}],
+    "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})";
+  EXPECT_EQ(wavetrace("render '" + path("t.json") + "' -o '" + path("t.png") + "' --backend cpu -q"), 2) << err_;
+  EXPECT_NE(err_.find("t.json: /render/noise_threshold: must be above 0 and at most 1 (got 2)"), std::string::npos) << err_;
+  std::ofstream(path("m.json")) << R"({"camera": {"look_from": [0, 0, 4], "look_at": [0, 0, 0]}, "render": {"min_spp": 8},
+    "materials": [{"name": "m", "type": "lambertian", "albedo": [0.5, 0.5, 0.5]}],
+    "spheres": [{"center": [0, 0, 0], "radius": 1, "material": "m"}]})";
+  EXPECT_EQ(wavetrace("render '" + path("m.json") + "' -o '" + path("t.png") + "' --backend cpu -q"), 2) << err_;
+  EXPECT_NE(err_.find("m.json: /render/min_spp: the samples every pixel takes before adaptive sampling stops any"),
+            std::string::npos) << err_;
+  EXPECT_EQ(count(err_, "\n"), 1u) << err_;
+  EXPECT_FALSE(fs::exists(path("t.png")));
 }
 
 }  // namespace
