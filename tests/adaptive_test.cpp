@@ -247,6 +247,70 @@ TEST(AdaptiveRender, EveryKernelTakesTheSameSamples) {
   if (!test::cuda_available()) GTEST_SKIP() << "the CPU's kernels agree; no CUDA device for the rest";
 }
 
+// Split over three host devices (each round's pixels cut between them), the render
+// is the one-device render bit for bit: every pixel's samples are rendered by one
+// device, in order. Each device took a part of every round.
+TEST(AdaptiveRender, SeveralDevicesRenderTheOneDeviceImage) {
+  const Scene scene = sky_and_sphere();
+  const RenderResult one = render(scene, adaptive_options(Backend::Cpu, Kernel::Megakernel, 0.03, 256));
+  RenderOptions three = adaptive_options(Backend::Cpu, Kernel::Megakernel, 0.03, 256);
+  three.devices = {0, 1, 2};
+  three.threads = 3;
+  const RenderResult r = render(scene, three);
+  EXPECT_EQ(r.pixel_samples, one.pixel_samples);
+  EXPECT_EQ(r.rgb, one.rgb);
+  EXPECT_EQ(r.variance, one.variance);
+  EXPECT_EQ(r.rays, one.rays);
+  ASSERT_EQ(r.shares.size(), 3u);
+  for (const DeviceShare& s : r.shares) {
+    SCOPED_TRACE(s.device);
+    EXPECT_GT(s.paths, 0u);
+    EXPECT_GT(s.chunks, 2) << "a part of each round";
+  }
+  if (!test::cuda_available()) GTEST_SKIP() << "the CPU's devices agree; no CUDA device to split over";
+  // One GPU twice: two renderers of the same device, each its own run of pixels.
+  const RenderResult gpu = render(scene, adaptive_options(Backend::Cuda, Kernel::Megakernel, 0.03, 256));
+  RenderOptions twice = adaptive_options(Backend::Cuda, Kernel::Megakernel, 0.03, 256);
+  twice.devices = {0, 0};
+  const RenderResult split = render(scene, twice);
+  EXPECT_EQ(split.pixel_samples, gpu.pixel_samples);
+  EXPECT_EQ(split.rgb, gpu.rgb);
+}
+
+// A render stopped after a step (after_step says so) holds its state; resumed from
+// that state, it ends as the uninterrupted render does, bit for bit.
+TEST(AdaptiveRender, AStoppedRenderResumedFromItsStateEndsAsTheWholeRender) {
+  const Scene scene = sky_and_sphere();
+  const RenderOptions o = adaptive_options(Backend::Cpu, Kernel::Megakernel, 0.03, 256);
+  const RenderResult whole = render(scene, o);
+  AdaptiveState kept;
+  int steps = 0;
+  AdaptiveHooks stop;
+  stop.after_step = [&](const AdaptiveState& s, bool) {
+    kept = s;
+    return ++steps < 2;
+  };
+  const RenderResult stopped = render(scene, o, stop);
+  EXPECT_TRUE(stopped.interrupted);
+  EXPECT_EQ(steps, 2);
+  EXPECT_LT(stopped.samples, whole.samples);
+  EXPECT_EQ(kept.check(24 * 16, 256), "");
+  AdaptiveHooks resume;
+  resume.resume = &kept;
+  std::vector<uint64_t> converged;
+  resume.converged = [&](uint64_t c) { converged.push_back(c); };
+  const RenderResult rest = render(scene, o, resume);
+  EXPECT_FALSE(rest.interrupted);
+  EXPECT_EQ(rest.pixel_samples, whole.pixel_samples);
+  EXPECT_EQ(rest.rgb, whole.rgb);
+  EXPECT_EQ(rest.variance, whole.variance);
+  EXPECT_EQ(stopped.rays + rest.rays, whole.rays);
+  // The progress line's count: never falling, ending at the render's.
+  ASSERT_FALSE(converged.empty());
+  EXPECT_TRUE(std::is_sorted(converged.begin(), converged.end()));
+  EXPECT_EQ(converged.back(), whole.converged);
+}
+
 // Bad settings: min_spp above spp.
 TEST(AdaptiveRender, MinSppAboveSppIsBadInput) {
   RenderOptions o = adaptive_options(Backend::Cpu, Kernel::Megakernel, 0.05, 8);

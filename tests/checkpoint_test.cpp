@@ -129,14 +129,15 @@ TEST_F(CheckpointTest, ADamagedOrCutOrForeignFileIsRefused) {
 
   // A later format, with its checksum made good: refused by its version.
   std::string later = bytes.substr(0, bytes.size() - 4);
-  const uint32_t version = kCheckpointFormat + 1;
+  const uint32_t version = kAdaptiveCheckpointFormat + 1;
   std::memcpy(&later[8], &version, sizeof version);
   const uint32_t crc = static_cast<uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(later.data()), later.size()));
   later.append(reinterpret_cast<const char*>(&crc), sizeof crc);
   write_bytes(path("later.ckpt"), later);
   EXPECT_EQ(refusal(path("later.ckpt")), path("later.ckpt") + ": not a usable checkpoint: format version " +
-                                             std::to_string(version) + "; this wavetrace reads version " +
-                                             std::to_string(kCheckpointFormat));
+                                             std::to_string(version) + "; this wavetrace reads versions " +
+                                             std::to_string(kCheckpointFormat) + " and " +
+                                             std::to_string(kAdaptiveCheckpointFormat));
 
   EXPECT_EQ(refusal(path("missing.ckpt")), path("missing.ckpt") + ": cannot open checkpoint (No such file or directory)");
 }
@@ -202,6 +203,111 @@ TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
   ASSERT_EQ(a.size(), b.size());
   // The same samples summed in another grouping: equal to float rounding.
   for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-5f * std::max(1.0f, a[i])) << i;
+}
+
+// An adaptive render (--noise-threshold) stopped by SIGTERM after its first step
+// keeps its halves, counts and converged pixels; resumed, it ends as the
+// uninterrupted render does, bit for bit (the megakernel sums each pixel's samples
+// in order), each pixel with the same samples.
+TEST_F(CheckpointTest, AnAdaptiveRenderStoppedBySigtermResumesToTheUninterruptedImage) {
+  auto adaptive = [&](const std::string& output) {
+    Job j = job(output);
+    j.kernel = "megakernel";
+    j.spp = 256;
+    j.noise_threshold = 0.05;
+    j.min_spp = 8;
+    j.aov = "spp";
+    return j;
+  };
+  const JobOutcome whole = run_job(adaptive(path("whole.pfm")));
+  ASSERT_EQ(whole.exit_code, 0) << whole.message;
+  ASSERT_GT(whole.result.samples, 16) << "the render ends in its first steps: nothing to resume";
+
+  Job first = adaptive(path("resumed.pfm"));
+  first.checkpoint = path("a.ckpt");
+  sigset_t term, previous;
+  sigemptyset(&term);
+  sigaddset(&term, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &term, &previous);
+  ::pthread_kill(::pthread_self(), SIGTERM);
+  const JobOutcome stopped = run_job(first);
+  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  EXPECT_EQ(stopped.exit_code, 128 + SIGTERM);
+  EXPECT_EQ(stopped.message, "interrupted by SIGTERM at sample 8 of 256; checkpoint written to " + path("a.ckpt") +
+                                 " (resume with --resume " + path("a.ckpt") + ")");
+  EXPECT_FALSE(fs::exists(path("resumed.pfm")));
+  const Checkpoint kept = read_checkpoint(path("a.ckpt"));
+  ASSERT_TRUE(kept.adaptive.has_value());
+  EXPECT_EQ(kept.adaptive->samples, 8);
+  EXPECT_EQ(kept.identity.noise_threshold, 0.05);
+  EXPECT_EQ(kept.identity.min_spp, 8);
+
+  // Another threshold does not resume it.
+  Job other = adaptive(path("other.pfm"));
+  other.noise_threshold = 0.1;
+  other.resume = path("a.ckpt");
+  const JobOutcome refused = run_job(other);
+  EXPECT_EQ(refused.exit_code, kExitBadInput);
+  EXPECT_NE(refused.message.find("noise_threshold 0.05, min_spp 8 in the checkpoint, noise_threshold 0.1, min_spp 8 now"),
+            std::string::npos)
+      << refused.message;
+
+  Job rest = adaptive(path("resumed.pfm"));
+  rest.resume = path("a.ckpt");
+  const JobOutcome resumed = run_job(rest);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.message;
+  EXPECT_EQ(resumed.resumed_from_sample, 8);
+  EXPECT_FALSE(fs::exists(path("a.ckpt")));
+  EXPECT_EQ(stopped.result.rays + resumed.result.rays, whole.result.rays);
+  EXPECT_EQ(resumed.result.pixel_samples, whole.result.pixel_samples);
+  EXPECT_EQ(resumed.result.converged, whole.result.converged);
+  EXPECT_EQ(test::read_pfm(path("whole.pfm"), 16, 16), test::read_pfm(path("resumed.pfm"), 16, 16));
+  EXPECT_EQ(bytes_of(path("whole.spp.pfm")), bytes_of(path("resumed.spp.pfm")));
+}
+
+// An adaptive state round-trips, and one whose counts its checksum vouches for but
+// which cannot be (a pixel still going with fewer samples than the render's) is
+// refused, naming the pixel.
+TEST_F(CheckpointTest, AnAdaptiveStateRoundTripsAndIsCheckedWhenRead) {
+  Checkpoint c = sample_checkpoint();  // 4 x 2, 16 spp
+  c.identity.noise_threshold = 0.02;
+  c.identity.min_spp = 4;
+  c.film.clear();
+  AdaptiveState a = AdaptiveState::start(8);
+  a.samples = 8;
+  for (size_t p = 0; p < 8; ++p) {
+    a.n_a[p] = a.n_b[p] = 4;
+    for (int k = 0; k < 3; ++k) {
+      a.half_a[3 * p + k] = 0.5f * static_cast<float>(p + k);
+      a.half_b[3 * p + k] = 0.25f * static_cast<float>(p + k);
+    }
+  }
+  a.converged[3] = 1;
+  c.adaptive = a;
+  write_checkpoint(path("a.ckpt"), c);
+  const Checkpoint back = read_checkpoint(path("a.ckpt"));
+  ASSERT_TRUE(back.adaptive.has_value());
+  EXPECT_EQ(back.samples, 8);
+  EXPECT_EQ(back.adaptive->half_a, a.half_a);
+  EXPECT_EQ(back.adaptive->half_b, a.half_b);
+  EXPECT_EQ(back.adaptive->n_a, a.n_a);
+  EXPECT_EQ(back.adaptive->n_b, a.n_b);
+  EXPECT_EQ(back.adaptive->converged, a.converged);
+  EXPECT_NO_THROW(require_same_render(path("a.ckpt"), back.identity, c.identity));
+  // A uniform render does not resume it.
+  Checkpoint uniform = sample_checkpoint();
+  try {
+    require_same_render(path("a.ckpt"), back.identity, uniform.identity);
+    ADD_FAILURE() << "an adaptive checkpoint resumed by a uniform render";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("noise_threshold 0.02, min_spp 4 in the checkpoint, a uniform render now"),
+              std::string::npos)
+        << e.what();
+  }
+  c.adaptive->n_b[5] = 3;  // still going, with 7 of 8 samples
+  write_checkpoint(path("bad.ckpt"), c);
+  EXPECT_EQ(refusal(path("bad.ckpt")), path("bad.ckpt") + ": not a usable checkpoint: pixel 5's adaptive counts (4, 3) "
+                                                          "do not fit its 8 samples");
 }
 
 TEST_F(CheckpointTest, ACheckpointHoldingEverySampleIsTheImage) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -39,8 +40,10 @@ void put(std::string& out, T value) {
 json identity_json(const CheckpointIdentity& id) {
   json settings = json::object();
   for (SettingId s : render_settings()) settings[setting(s).key] = get_param(id.params, s);
-  return {{"scene", id.scene},   {"scene_crc32", id.scene_crc}, {"settings", settings},
-          {"kernel", id.kernel}, {"backend", id.backend},       {"renderer", id.renderer}};
+  json j = {{"scene", id.scene},   {"scene_crc32", id.scene_crc}, {"settings", settings},
+            {"kernel", id.kernel}, {"backend", id.backend},       {"renderer", id.renderer}};
+  if (id.noise_threshold != 0) j["adaptive"] = {{"noise_threshold", id.noise_threshold}, {"min_spp", id.min_spp}};
+  return j;
 }
 
 [[noreturn]] void damaged(const std::string& path, const std::string& what) {
@@ -74,38 +77,106 @@ void read_header(const std::string& path, const std::string& text, Checkpoint& c
     c.identity.kernel = header.at("kernel").get<std::string>();
     c.identity.backend = header.at("backend").get<std::string>();
     c.identity.renderer = header.at("renderer").get<std::string>();
+    if (header.contains("adaptive")) {
+      const json& a = header.at("adaptive");
+      if (!a.at("noise_threshold").is_number()) damaged(path, "its adaptive noise_threshold is not a number");
+      c.identity.noise_threshold = a.at("noise_threshold").get<double>();
+      c.identity.min_spp = static_cast<int32_t>(whole_number(path, a.at("min_spp"), "min_spp", 0, kMaxSpp));
+    }
     c.samples = static_cast<int32_t>(whole_number(path, header.at("samples"), "samples", 0, c.identity.params.spp));
   } catch (const nlohmann::json::exception& e) {
     damaged(path, std::string("its header cannot be read (") + e.what() + ")");
   }
 }
 
-// The film that follows the header at byte `at`: the render's size, every value a
-// sum of radiance (which is never negative, so neither is a sum of samples of it).
-void read_film(const std::string& path, const std::string& bytes, size_t at, Checkpoint& c) {
-  uint64_t floats = 0;
-  std::memcpy(&floats, bytes.data() + at, sizeof floats);
-  const uint64_t expected = uint64_t{3} * static_cast<uint64_t>(c.identity.params.width) *
-                            static_cast<uint64_t>(c.identity.params.height);
-  if (floats != expected) {
-    damaged(path, "its film holds " + std::to_string(floats) + " values; a " + std::to_string(c.identity.params.width) +
-                      " x " + std::to_string(c.identity.params.height) + " render's holds " + std::to_string(expected));
+// The bytes after the header, read in order: each array a u64 count, then its values.
+class Body {
+ public:
+  Body(const std::string& path, const std::string& bytes, size_t at, const RenderParams& p)
+      : path_(path), bytes_(bytes), at_(at),
+        render_("a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " render's") {}
+
+  // An array of exactly `expected` values of T.
+  template <class T>
+  std::vector<T> array(uint64_t expected, const std::string& what) {
+    uint64_t count = 0;
+    take(&count, sizeof count, what);
+    if (count != expected) {
+      damaged(path_, "its " + what + " holds " + std::to_string(count) + " values; " + render_ + " holds " +
+                         std::to_string(expected));
+    }
+    std::vector<T> out(count);
+    take(out.data(), count * sizeof(T), what);
+    return out;
   }
-  if (at + sizeof floats + floats * sizeof(float) + sizeof(uint32_t) != bytes.size()) {
-    damaged(path, "its film is not the size its header says");
+
+  // Nothing but the CRC-32 is left.
+  void end() const {
+    if (at_ + sizeof(uint32_t) != bytes_.size()) damaged(path_, "its film is not the size its header says");
   }
-  c.film.resize(floats);
-  std::memcpy(c.film.data(), bytes.data() + at + sizeof floats, floats * sizeof(float));
-  for (size_t i = 0; i < c.film.size(); ++i) {
-    const float v = c.film[i];
+
+ private:
+  void take(void* to, size_t n, const std::string& what) {
+    if (bytes_.size() < sizeof(uint32_t) || at_ + n > bytes_.size() - sizeof(uint32_t)) {
+      damaged(path_, "its " + what + " is cut short");
+    }
+    std::memcpy(to, bytes_.data() + at_, n);
+    at_ += n;
+  }
+
+  const std::string& path_;
+  const std::string& bytes_;
+  size_t at_;
+  std::string render_;
+};
+
+// A film of sums of radiance (which is never negative, so neither is a sum of
+// samples of it): every value finite and at least 0.
+void check_film(const std::string& path, const std::vector<float>& film, int32_t width, const char* what) {
+  for (size_t i = 0; i < film.size(); ++i) {
+    const float v = film[i];
     if (!std::isfinite(v) || v < 0.0f) {
       const size_t pixel = i / 3;
-      const size_t w = static_cast<size_t>(c.identity.params.width);
-      damaged(path, "its film's pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) + ") holds " +
+      const size_t w = static_cast<size_t>(width);
+      damaged(path, std::string("its ") + what + "'s pixel (" + std::to_string(pixel % w) + ", " +
+                        std::to_string(pixel / w) + ") holds " +
                         (std::isnan(v) ? std::string("NaN") : std::isinf(v) ? "an infinity" : std::to_string(v)) +
                         "; a sum of radiance is finite and at least 0");
     }
   }
+}
+
+// What follows the header at byte `at`: the film of the render's size, or of an
+// adaptive render its halves, counts and converged pixels.
+void read_body(const std::string& path, const std::string& bytes, size_t at, uint32_t format, Checkpoint& c) {
+  const RenderParams& p = c.identity.params;
+  const uint64_t pixels = static_cast<uint64_t>(p.width) * static_cast<uint64_t>(p.height);
+  Body body(path, bytes, at, p);
+  if (format == kCheckpointFormat) {
+    c.film = body.array<float>(3 * pixels, "film");
+    body.end();
+    check_film(path, c.film, p.width, "film");
+    return;
+  }
+  AdaptiveState a;
+  a.samples = c.samples;
+  a.half_a = body.array<float>(3 * pixels, "first half's film");
+  a.half_b = body.array<float>(3 * pixels, "second half's film");
+  a.n_a = body.array<int32_t>(pixels, "first half's counts");
+  a.n_b = body.array<int32_t>(pixels, "second half's counts");
+  a.converged = body.array<uint8_t>(pixels, "converged pixels");
+  body.end();
+  check_film(path, a.half_a, p.width, "first half's film");
+  check_film(path, a.half_b, p.width, "second half's film");
+  const std::string wrong = a.check(pixels, p.spp);
+  if (!wrong.empty()) damaged(path, wrong);
+  c.adaptive = std::move(a);
+}
+
+template <class T>
+void put_array(std::string& out, const std::vector<T>& values) {
+  put<uint64_t>(out, values.size());
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
 
 }  // namespace
@@ -123,17 +194,26 @@ CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderPar
 }
 
 // Layout (little-endian): magic, u32 format, u32 header length, the header (JSON:
-// identity and samples), u64 float count, the film's floats, u32 CRC-32 of all before.
+// identity and samples), the body (each array a u64 count and its values): the film,
+// or (format 2) an adaptive render's halves, counts and converged pixels; then u32
+// CRC-32 of all before.
 void write_checkpoint(const std::string& path, const Checkpoint& c) {
   json header = identity_json(c.identity);
-  header["samples"] = c.samples;
+  header["samples"] = c.adaptive ? c.adaptive->samples : c.samples;
   const std::string text = header.dump();
   std::string out(kMagic, sizeof kMagic);
-  put<uint32_t>(out, kCheckpointFormat);
+  put<uint32_t>(out, c.adaptive ? kAdaptiveCheckpointFormat : kCheckpointFormat);
   put<uint32_t>(out, static_cast<uint32_t>(text.size()));
   out += text;
-  put<uint64_t>(out, c.film.size());
-  out.append(reinterpret_cast<const char*>(c.film.data()), c.film.size() * sizeof(float));
+  if (c.adaptive) {
+    put_array(out, c.adaptive->half_a);
+    put_array(out, c.adaptive->half_b);
+    put_array(out, c.adaptive->n_a);
+    put_array(out, c.adaptive->n_b);
+    put_array(out, c.adaptive->converged);
+  } else {
+    put_array(out, c.film);
+  }
   put<uint32_t>(out, crc_of(out.data(), out.size()));
   write_file(path, out);
 }
@@ -153,14 +233,18 @@ Checkpoint read_checkpoint(const std::string& path) {
   uint32_t format = 0, header_bytes = 0;
   std::memcpy(&format, bytes.data() + sizeof kMagic, sizeof format);
   std::memcpy(&header_bytes, bytes.data() + sizeof kMagic + sizeof format, sizeof header_bytes);
-  if (format != kCheckpointFormat) {
-    damaged(path, "format version " + std::to_string(format) + "; this wavetrace reads version " +
-                      std::to_string(kCheckpointFormat));
+  if (format != kCheckpointFormat && format != kAdaptiveCheckpointFormat) {
+    damaged(path, "format version " + std::to_string(format) + "; this wavetrace reads versions " +
+                      std::to_string(kCheckpointFormat) + " and " + std::to_string(kAdaptiveCheckpointFormat));
   }
   if (fixed + header_bytes + sizeof(uint64_t) + sizeof(uint32_t) > bytes.size()) damaged(path, "its header is cut short");
   Checkpoint c;
   read_header(path, bytes.substr(fixed, header_bytes), c);
-  read_film(path, bytes, fixed + header_bytes, c);
+  if ((format == kAdaptiveCheckpointFormat) != (c.identity.noise_threshold != 0)) {
+    damaged(path, format == kAdaptiveCheckpointFormat ? "format 2 (an adaptive render's) without its adaptive header"
+                                                      : "an adaptive header in format 1");
+  }
+  read_body(path, bytes, fixed + header_bytes, format, c);
   return c;
 }
 
@@ -179,6 +263,15 @@ void require_same_render(const std::string& path, const CheckpointIdentity& then
       refuse(std::string(setting(s).key) + " " + std::to_string(a) + " in the checkpoint, " + std::to_string(b) +
              " now");
     }
+  }
+  if (then.noise_threshold != now.noise_threshold || then.min_spp != now.min_spp) {
+    const auto adaptive = [](const CheckpointIdentity& id) {
+      if (id.noise_threshold == 0) return std::string("a uniform render");
+      char text[96];
+      std::snprintf(text, sizeof text, "noise_threshold %g, min_spp %d", id.noise_threshold, id.min_spp);
+      return std::string(text);
+    };
+    refuse(adaptive(then) + " in the checkpoint, " + adaptive(now) + " now");
   }
   if (then.kernel != now.kernel || then.backend != now.backend) {
     refuse(then.backend + "/" + then.kernel + " in the checkpoint, " + now.backend + "/" + now.kernel + " now");

@@ -4,14 +4,19 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "render/adaptive.hpp"
 #include "render/render_types.hpp"
 
 namespace wt::app {
 
+// Version 1: a film of sums and the samples done. Version 2 (an adaptive render's):
+// besides, the halves and counts of render/adaptive.hpp's AdaptiveState.
 constexpr uint32_t kCheckpointFormat = 1;
+constexpr uint32_t kAdaptiveCheckpointFormat = 2;
 
 // What a checkpoint must match to be resumed: the scene file's bytes, the render's
 // settings, the kernel and backend, and the renderer's version.
@@ -20,6 +25,10 @@ struct CheckpointIdentity {
   uint32_t scene_crc = 0;    // CRC-32 of its bytes
   RenderParams params{};
   std::string kernel, backend;
+  // An adaptive render's threshold (-1: its rounds without a threshold, for the
+  // variance AOV) and the samples every pixel takes first; 0, 0 for a uniform render.
+  double noise_threshold = 0;
+  int32_t min_spp = 0;
   std::string renderer = kRendererVersion;
 
   static constexpr const char* kRendererVersion = "wavetrace 0.3 (light transport of 2026-11)";
@@ -33,6 +42,10 @@ struct Checkpoint {
   CheckpointIdentity identity;
   int32_t samples = 0;       // samples of every pixel the film sums, from sample 0
   std::vector<float> film;   // linear RGB sums per pixel, row 0 = top
+  // An adaptive render's state between two steps (identity.noise_threshold != 0): its
+  // halves, counts and converged pixels; `samples` is then its samples and `film`
+  // empty.
+  std::optional<AdaptiveState> adaptive;
 };
 
 // Writes atomically (temporary file renamed into place); throws OutputError.

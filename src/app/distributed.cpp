@@ -2,32 +2,21 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <exception>
 #include <map>
 #include <optional>
 #include <nlohmann/json.hpp>
 
 #include "app/stats.hpp"
+#include "dispatch/split.hpp"
 
 namespace wt::app {
 
 using nlohmann::json;
 
 std::vector<SamplePass> rank_samples(int32_t first, int32_t count, const std::vector<double>& weights) {
-  std::vector<SamplePass> out;
-  double total = 0;
-  for (double w : weights) total += w;
-  // Cumulative rounding: each boundary is the rounded share of the weights before it,
-  // so the ranges tile [first, first + count) exactly.
-  double before = 0;
-  int32_t at = first;
-  for (size_t r = 0; r < weights.size(); ++r) {
-    before += weights[r];
-    const int32_t end =
-        r + 1 == weights.size() ? first + count : first + static_cast<int32_t>(std::llround(count * (before / total)));
-    out.push_back(SamplePass{at, end - at});
-    at = end;
-  }
-  return out;
+  return weighted_ranges(first, count, weights);
 }
 
 std::vector<int> local_share(const std::vector<int>& devices, int local_rank, int local_ranks) {
@@ -100,7 +89,7 @@ std::optional<json> take_decision(const Cluster& cluster, JobOutcome& out, const
 }  // namespace
 
 bool agree_on_samples(const Cluster& cluster, JobOutcome& out, RenderOptions& options, const std::string& signature,
-                      double weight) {
+                      double weight, std::vector<double>* weights_out) {
   json mine = status_of(cluster, out);
   mine["signature"] = signature;
   mine["weight"] = weight;
@@ -135,6 +124,7 @@ bool agree_on_samples(const Cluster& cluster, JobOutcome& out, RenderOptions& op
         ranges.push_back({p.first, p.count});
       }
       decision["ranges"] = ranges;
+      decision["weights"] = weights;
     }
   } else {
     cluster.gather(mine.dump());
@@ -144,10 +134,119 @@ bool agree_on_samples(const Cluster& cluster, JobOutcome& out, RenderOptions& op
   const json& range = (*d)["ranges"][static_cast<size_t>(cluster.rank())];
   options.first_sample = range[0].get<int32_t>();
   options.sample_count = range[1].get<int32_t>();
+  if (weights_out) *weights_out = (*d)["weights"].get<std::vector<double>>();
   return true;
 }
 
-void combine_results(const Cluster& cluster, JobOutcome& out) {
+namespace {
+
+// An adaptive render's messages from rank 0: a round ('R', its first sample and
+// count, the pixels still going, none listed where every pixel is), or the end ('E').
+template <class T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+std::string round_message(const RenderOptions& o) {
+  std::string m = "R";
+  put<int32_t>(m, o.first_sample);
+  put<int32_t>(m, o.sample_count);
+  if (o.active_pixels) {
+    m.append(reinterpret_cast<const char*>(o.active_pixels->data()), o.active_pixels->size() * sizeof(uint32_t));
+  }
+  return m;
+}
+
+struct Round {
+  int32_t first = 0, count = 0;
+  bool listed = false;
+  std::vector<uint32_t> pixels;
+};
+
+Round read_round(const std::string& m) {
+  Round r;
+  std::memcpy(&r.first, m.data() + 1, sizeof r.first);
+  std::memcpy(&r.count, m.data() + 1 + sizeof r.first, sizeof r.count);
+  const size_t head = 1 + 2 * sizeof(int32_t);
+  r.listed = m.size() > head;
+  r.pixels.resize((m.size() - head) / sizeof(uint32_t));
+  std::memcpy(r.pixels.data(), m.data() + head, r.pixels.size() * sizeof(uint32_t));
+  return r;
+}
+
+void add_counts(RenderResult& to, const RenderResult& r) {
+  to.rays += r.rays;
+  to.shadow_rays += r.shadow_rays;
+  to.paths += r.paths;
+  to.seconds += r.seconds;
+  to.upload_seconds = std::max(to.upload_seconds, r.upload_seconds);
+  if (!r.device.empty()) to.device = r.device;
+}
+
+}  // namespace
+
+RenderResult render_adaptive_ranks(const Cluster& cluster, const ChunkRenderer& rounds, const RenderOptions& options,
+                                   const std::vector<double>& weights, const AdaptiveHooks& hooks) {
+  const RenderParams& rp = options.params;
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  std::exception_ptr failed;  // this rank's first error: it renders no more
+  RenderResult mine;          // this rank's counts
+  // This rank's run of a round's pixels rendered, the runs' sums added on rank 0.
+  auto part = [&](int32_t first, int32_t count, const std::vector<uint32_t>* listed) {
+    const size_t n = listed ? listed->size() : pixels;
+    const SamplePass cut = weighted_ranges(0, static_cast<int32_t>(n), weights)[static_cast<size_t>(cluster.rank())];
+    std::vector<uint32_t> run(static_cast<size_t>(cut.count));
+    for (size_t i = 0; i < run.size(); ++i) {
+      const size_t at = static_cast<size_t>(cut.first) + i;
+      run[i] = listed ? (*listed)[at] : static_cast<uint32_t>(at);
+    }
+    RenderResult r;
+    if (!failed && !run.empty()) {
+      try {
+        RenderOptions o = options;
+        o.first_sample = first;
+        o.sample_count = count;
+        o.active_pixels = &run;
+        o.progress = nullptr;
+        o.warmup = 0;
+        r = rounds(o);
+        add_counts(mine, r);
+      } catch (...) {
+        failed = std::current_exception();
+        r = RenderResult();
+      }
+    }
+    if (r.rgb.size() != pixels * 3) r.rgb.assign(pixels * 3, 0.0f);
+    cluster.sum_to_root(r.rgb);
+    return r;
+  };
+  if (!cluster.root()) {
+    for (std::string m = cluster.broadcast(""); !m.empty() && m[0] == 'R'; m = cluster.broadcast("")) {
+      const Round round = read_round(m);
+      part(round.first, round.count, round.listed ? &round.pixels : nullptr);
+    }
+    if (failed) std::rethrow_exception(failed);
+    return mine;
+  }
+  RenderResult out;
+  try {
+    out = render_adaptive_rounds(
+        [&](const RenderOptions& o) {
+          cluster.broadcast(round_message(o));
+          RenderResult r = part(o.first_sample, o.sample_count, o.active_pixels);
+          if (failed) std::rethrow_exception(failed);
+          return r;  // every rank's sums; rank 0's counts
+        },
+        options, hooks);
+  } catch (...) {
+    cluster.broadcast("E");
+    throw;
+  }
+  cluster.broadcast("E");
+  return out;
+}
+
+void combine_results(const Cluster& cluster, JobOutcome& out, bool adaptive) {
   const RenderResult& r = out.result;
   json mine = status_of(cluster, out);
   if (out.exit_code == 0) {
@@ -178,13 +277,22 @@ void combine_results(const Cluster& cluster, JobOutcome& out) {
     cluster.gather(mine.dump());
   }
   if (!take_decision(cluster, out, decision)) return;
-  cluster.sum_to_root(out.result.rgb);
+  if (!adaptive) cluster.sum_to_root(out.result.rgb);
   if (!cluster.root()) return;
   // The whole render, as rank 0 reports it: every rank's counts, and its devices.
   RenderResult whole;
-  whole.rgb = std::move(out.result.rgb);
-  whole.radiance = Radiance::SumOfSamples;
-  whole.samples = out.params.spp;
+  if (adaptive) {
+    // Rank 0's image is the whole render's already (with its counts, samples and
+    // variance); its counts give way to every rank's.
+    whole = std::move(out.result);
+    whole.rays = whole.shadow_rays = whole.paths = 0;
+    whole.seconds = whole.upload_seconds = 0;
+    whole.shares.clear();
+  } else {
+    whole.rgb = std::move(out.result.rgb);
+    whole.radiance = Radiance::SumOfSamples;
+    whole.samples = out.params.spp;
+  }
   whole.device = std::to_string(cluster.ranks()) + " ranks";
   for (size_t rank = 0; rank < statuses.size(); ++rank) {
     const json& s = statuses[rank]["result"];

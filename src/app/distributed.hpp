@@ -11,6 +11,7 @@
 
 #include "app/cluster.hpp"
 #include "app/job.hpp"
+#include "dispatch/renderer.hpp"
 #include "render/passes.hpp"
 
 namespace wt::app {
@@ -41,13 +42,28 @@ std::string describe_failures(const std::vector<RankStatus>& failed, int ranks);
 // and scene's counts). Then each rank's share of the samples, in proportion to
 // `weight` (its devices), set into `options`. Where any rank failed, every rank's
 // `out` fails with the line that says which and why; returns whether all is well.
+// `weights`, where given, gets every rank's weight (an adaptive render's ranks share
+// each round's pixels by them).
 bool agree_on_samples(const Cluster& cluster, JobOutcome& out, RenderOptions& options, const std::string& signature,
-                      double weight);
+                      double weight, std::vector<double>* weights = nullptr);
+
+// Collective: an adaptive render (render/adaptive.hpp) over the ranks. Rank 0 runs it,
+// and before each round sends every rank the round (its samples, the pixels still
+// going); each rank renders its run of those pixels (cut in proportion to
+// `weights`) with `rounds` (its devices', dispatch/renderer.hpp's adaptive_rounds),
+// and rank 0 adds the runs' sums (each pixel's from one rank alone: the image is the
+// one-process image). Rank 0's result is the whole render's image; every rank's
+// counts are its own. A rank whose round fails renders no more, adds zeros, and
+// reports its error at the end (combine_results), as rank 0 does.
+RenderResult render_adaptive_ranks(const Cluster& cluster, const ChunkRenderer& rounds, const RenderOptions& options,
+                                   const std::vector<double>& weights, const AdaptiveHooks& hooks);
 
 // Collective, after the render: every rank's outcome; where all rendered, rank 0's
 // result becomes the whole render's (the film's sums over every sample, in rank
 // order; rays, paths and each rank's share), the others' stay their own. Where any
 // failed, every rank's `out` fails with the line that says which and why.
-void combine_results(const Cluster& cluster, JobOutcome& out);
+// Of an adaptive render (`adaptive`), rank 0's image is already the whole one and
+// only the counts are combined.
+void combine_results(const Cluster& cluster, JobOutcome& out, bool adaptive = false);
 
 }  // namespace wt::app

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <thread>
@@ -24,6 +25,8 @@
 #include "render/adaptive.hpp"
 
 namespace wt::app {
+
+using nlohmann::json;
 
 Backend parse_backend(const std::string& name) {
   if (name == "cuda") return Backend::Cuda;
@@ -166,7 +169,11 @@ std::string render_signature(const JobOutcome& o) {
   const RenderParams& p = o.params;
   return std::to_string(p.width) + "x" + std::to_string(p.height) + ", " + std::to_string(p.spp) + " spp, depth " +
          std::to_string(p.depth) + ", roulette depth " + std::to_string(p.roulette_depth) + ", seed " +
-         std::to_string(p.seed) + ", light sampling " + std::to_string(p.nee) + ", " + o.backend + "/" + o.kernel +
+         std::to_string(p.seed) + ", light sampling " + std::to_string(p.nee) +
+         (o.noise_threshold != 0 ? ", noise threshold " + json(o.noise_threshold).dump() + " min spp " +
+                                       std::to_string(o.min_spp)
+                                 : std::string()) +
+         ", " + o.backend + "/" + o.kernel +
          ", " + std::to_string(o.geometry.spheres) + " spheres and " + std::to_string(o.geometry.instanced_triangles) +
          " triangles";
 }
@@ -208,21 +215,13 @@ class ContextStart {
 // nothing, and no output may overwrite another. Of an MPI run, rank 0 alone writes
 // (and keeps no checkpoint).
 void check_outputs(const Job& job, bool distributed) {
-  if (job.noise_threshold && !(*job.noise_threshold > 0)) {
-    char got[32];
-    std::snprintf(got, sizeof got, "%g", *job.noise_threshold);
-    throw InputError(std::string("--noise-threshold: must be above 0 (got ") + got + ")");
-  }
-  const bool variance = job_asks_for(job, AovKind::Variance);
-  if (job.noise_threshold || variance) {
-    const char* what = job.noise_threshold ? "--noise-threshold" : "--aov variance";
-    if (!checkpoint_of(job).empty()) {
-      throw InputError(std::string(what) + ": an adaptive render keeps no checkpoint yet; render it without --checkpoint/--resume");
+  if (job.noise_threshold) {
+    const Setting& t = setting(SettingId::NoiseThreshold);
+    try {
+      check_real_setting(t.id, *job.noise_threshold);
+    } catch (const InputError& e) {
+      throw InputError(std::string(t.flag) + std::string(e.what()).substr(std::strlen(t.key)));
     }
-    if (distributed) throw InputError(std::string(what) + ": an adaptive render runs in one process, not over MPI ranks yet");
-  }
-  if (job.min_spp > 0 && !job.noise_threshold) {
-    throw InputError("--min-spp: the samples every pixel takes before adaptive sampling stops any; give --noise-threshold too");
   }
   if (job.keep_noisy && !job.denoise) throw InputError("--keep-noisy: keeps the render beside a denoised image: give --denoise too");
   if (job.denoise) {
@@ -256,8 +255,15 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.shade_by_kind = job.profile;
   options.wave_size = job.wave_size;
   options.megakernel_batch = static_cast<int32_t>(job.megakernel_batch);
-  options.noise_threshold = job.noise_threshold.value_or(0.0);
-  options.min_spp = static_cast<int32_t>(job.min_spp);
+  // Adaptive sampling: the job's, else the scene's `render` section's.
+  options.noise_threshold = job.noise_threshold.value_or(scene.render.noise_threshold);
+  options.min_spp = static_cast<int32_t>(job.min_spp > 0 ? job.min_spp : scene.render.min_spp);
+  if (options.min_spp > 0 && options.noise_threshold == 0) {
+    throw InputError(job.min_spp > 0 ? "--min-spp: the samples every pixel takes before adaptive sampling stops any; "
+                                       "give --noise-threshold too"
+                                     : job.scene + ": /render/min_spp: the samples every pixel takes before adaptive "
+                                                   "sampling stops any; give noise_threshold too");
+  }
   // The variance AOV is the adaptive rounds' estimate: without a threshold, the same
   // rounds with no pixel stopping.
   if (options.noise_threshold == 0 && job_asks_for(job, AovKind::Variance)) options.noise_threshold = -1;
@@ -298,6 +304,10 @@ void load_job(const Job& job, const Cluster& cluster, JobOutcome& out, std::opti
   }
   options = resolve_options(job, *scene);
   out.params = options.params;
+  if (options.noise_threshold != 0) {
+    out.noise_threshold = options.noise_threshold;
+    out.min_spp = resolved_min_spp(options.min_spp, options.params.spp);
+  }
   out.backend = backend_name(options.backend);
   out.kernel = kernel_name(options.kernel);
   if (cluster.distributed()) take_rank_share(job, cluster, options);
@@ -309,38 +319,76 @@ struct CheckpointState {
   std::optional<SignalCatcher> signals;
   // Once a pass says stop, the render ends as it is: its progress line stays where it was.
   std::atomic<bool> stopping{false};
+  // An adaptive render's: where it resumes from, and what it does after each step.
+  AdaptiveHooks adaptive;
+};
+
+// Whether a checkpoint is due: on a signal (and the render stops), or every
+// checkpoint_every seconds until the last pass or step.
+class CheckpointClock {
+ public:
+  CheckpointClock(CheckpointState& state, int64_t every_seconds) : state_(state), every_(every_seconds) {}
+  // Returns {write now, go on}.
+  std::pair<bool, bool> due(bool last) {
+    const bool stop = state_.signals->caught() != 0;
+    if (stop) state_.stopping = true;
+    const auto now = std::chrono::steady_clock::now();
+    const bool write = stop || (!last && now - last_write_ >= std::chrono::seconds(every_));
+    if (write) last_write_ = now;
+    return {write, !stop};
+  }
+
+ private:
+  CheckpointState& state_;
+  int64_t every_;
+  std::chrono::steady_clock::time_point last_write_ = std::chrono::steady_clock::now();
 };
 
 // Locks the job's checkpoint (held until the image is written), resumes from the one
 // there is, and has the render write it every checkpoint_every seconds and when a
-// signal stops it, in passes short enough that a signal is answered within about
-// 1/256 of the render.
+// signal stops it: a uniform render in passes short enough that a signal is answered
+// within about 1/256 of the render, an adaptive one after each of its steps.
 void watch_checkpoint(const Job& job, const JobOutcome& out, RenderOptions& options, CheckpointState& state,
                       CheckpointLock& lock) {
   const RenderParams& rp = options.params;
   const std::string& path = checkpoint_of(job);
   lock = CheckpointLock(path);
-  const CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
+  CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
+  identity.noise_threshold = out.noise_threshold;
+  identity.min_spp = out.min_spp;
   const std::string from =
       !job.resume.empty() ? job.resume : (std::filesystem::exists(job.checkpoint) ? job.checkpoint : "");
+  const bool adaptive = options.noise_threshold != 0;
   if (!from.empty()) {
     state.resumed = read_checkpoint(from);
     require_same_render(from, state.resumed.identity, identity);
-    options.first_sample = state.resumed.samples;
-    options.initial_film = &state.resumed.film;
+    if (adaptive) {
+      state.adaptive.resume = &*state.resumed.adaptive;
+      state.resumed.samples = state.resumed.adaptive->samples;
+    } else {
+      options.first_sample = state.resumed.samples;
+      options.initial_film = &state.resumed.film;
+    }
+  }
+  state.signals.emplace();
+  if (adaptive) {
+    state.adaptive.after_step = [&path, identity, clock = CheckpointClock(state, job.checkpoint_every)](
+                                    const AdaptiveState& now, bool last) mutable {
+      const auto [write, go_on] = clock.due(last);
+      if (write) {
+        Checkpoint c{identity, now.samples, {}, now};
+        write_checkpoint(path, c);
+      }
+      return go_on;
+    };
+    return;
   }
   options.samples_per_pass = std::max(1, rp.spp / 256);
-  state.signals.emplace();
-  options.after_pass = [&state, &job, &path, spp = rp.spp, identity, last_write = std::chrono::steady_clock::now()](
+  options.after_pass = [&path, spp = rp.spp, identity, clock = CheckpointClock(state, job.checkpoint_every)](
                            int32_t samples, const FilmReader& film) mutable {
-    const bool stop = state.signals->caught() != 0;
-    if (stop) state.stopping = true;
-    const auto now = std::chrono::steady_clock::now();
-    if (stop || (samples < spp && now - last_write >= std::chrono::seconds(job.checkpoint_every))) {
-      write_checkpoint(path, Checkpoint{identity, samples, film()});
-      last_write = now;
-    }
-    return !stop;
+    const auto [write, go_on] = clock.due(samples >= spp);
+    if (write) write_checkpoint(path, Checkpoint{identity, samples, film(), std::nullopt});
+    return go_on;
   };
 }
 
@@ -361,13 +409,17 @@ void render_alone(const Job& job, const Scene& scene, RenderOptions& options, Jo
     out.result.samples = rp.spp;
     take_mean(out.result);
   } else {
-    ProgressLine progress(static_cast<uint64_t>(rp.width) * rp.height * (rp.spp - options.first_sample));
+    const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
+    ProgressLine progress(pixels * (rp.spp - options.first_sample));
     if (job.progress) {
       options.progress = [&state, draw = progress.callback()](double done, uint64_t rays, double seconds) {
         if (!state.stopping) draw(done, rays, seconds);
       };
+      if (options.noise_threshold > 0) {
+        state.adaptive.converged = [&progress, pixels](uint64_t converged) { progress.converged(converged, pixels); };
+      }
     }
-    out.result = render(scene, options);
+    out.result = render(scene, options, state.adaptive);
   }
   if (out.result.interrupted) {
     const int sig = state.signals->caught();
@@ -381,10 +433,24 @@ void render_alone(const Job& job, const Scene& scene, RenderOptions& options, Jo
 }
 
 // The second phase as a rank of an MPI run: this rank's samples' sums (rank 0 adds
-// the others' to its own).
+// the others' to its own); of an adaptive render, this rank's part of each round
+// (render_adaptive_ranks), rank 0's result the whole image.
 void render_rank(const Job& job, const Scene& scene, RenderOptions& options, const Cluster& cluster,
-                 JobOutcome& out) {
+                 const std::vector<double>& weights, JobOutcome& out) {
   const RenderParams& rp = options.params;
+  if (options.noise_threshold != 0) {
+    const uint64_t pixels = static_cast<uint64_t>(rp.width) * rp.height;
+    ProgressLine progress(pixels * rp.spp);
+    AdaptiveHooks hooks;
+    if (job.progress && cluster.root()) {
+      options.progress = progress.callback();
+      if (options.noise_threshold > 0) {
+        hooks.converged = [&progress, pixels](uint64_t converged) { progress.converged(converged, pixels); };
+      }
+    }
+    out.result = render_adaptive_ranks(cluster, adaptive_rounds(scene, options), options, weights, hooks);
+    return;
+  }
   if (options.sample_count == 0) {
     out.result.rgb.assign(static_cast<size_t>(rp.width) * rp.height * 3, 0.0f);
     out.result.device = "no samples";
@@ -482,6 +548,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   const ContextStart context(job);
   std::optional<Scene> scene;
   RenderOptions options;
+  std::vector<double> rank_weights;  // of an MPI run: each rank's share
   // Held from before the checkpoint is read until the image is written.
   CheckpointLock checkpoint_lock;
   // Each phase guarded, so that every rank of an MPI run reaches every exchange.
@@ -489,25 +556,25 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   if (distributed) {
     const double weight = options.backend == Backend::Cuda ? std::max<size_t>(1, options.devices.size())
                                                            : std::max(1, options.threads);
-    if (!agree_on_samples(cluster, out, options, render_signature(out), weight)) return out;
+    if (!agree_on_samples(cluster, out, options, render_signature(out), weight, &rank_weights)) return out;
     out.ranks = cluster.ranks();
   }
   const auto started = std::chrono::steady_clock::now();
   if (out.exit_code != 0) return out;
   guarded(out, [&] {
     if (distributed) {
-      render_rank(job, *scene, options, cluster, out);
+      render_rank(job, *scene, options, cluster, rank_weights, out);
     } else {
       render_alone(job, *scene, options, out, checkpoint_lock);
     }
   });
   if (distributed) {
-    combine_results(cluster, out);
+    combine_results(cluster, out, options.noise_threshold != 0);
     out.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   }
   if (out.exit_code != 0 || !cluster.root()) return out;
   guarded(out, [&] {
-    if (distributed) take_mean(out.result);
+    if (distributed && out.result.radiance == Radiance::SumOfSamples) take_mean(out.result);
     // The AOVs and the denoiser's guides: one first-surface pass over the whole
     // render's samples, whatever kernel, checkpoint or ranks made the image.
     bool first_surface = job.denoise;
@@ -536,9 +603,9 @@ void print_outcome(const Job& job, const JobOutcome& o) {
                  o.wall_seconds);
   }
   const double pixels = static_cast<double>(o.params.width) * o.params.height;
-  if (job.noise_threshold && pixels > 0) {
+  if (o.noise_threshold > 0 && pixels > 0) {
     std::fprintf(stderr, "  adaptive: %llu of %.0f pixels converged under %g; %.1f spp on average, %d at most\n",
-                 static_cast<unsigned long long>(r.converged), pixels, *job.noise_threshold, mean_spp(r),
+                 static_cast<unsigned long long>(r.converged), pixels, o.noise_threshold, mean_spp(r),
                  r.samples);
   }
   for (const DeviceShare& s : r.shares) {

@@ -64,6 +64,10 @@ struct JobOutcome {
   // faulted): this process's CUDA context is lost, and no later CUDA work in it can run.
   bool device_lost = false;
   RenderParams params{};
+  // Adaptive sampling as the render took it (the job's or the scene's): its threshold
+  // (0: a uniform render) and min_spp.
+  double noise_threshold = 0;
+  int32_t min_spp = 0;
   LoadTimes load_times;
   Scene::Summary geometry;
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held

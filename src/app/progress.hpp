@@ -1,5 +1,6 @@
 // The progress line on stderr: shown once a render has run for a second, redrawn
-// a few times a second, with paths done, rays per second and the time left.
+// a few times a second, with paths done, rays per second and the time left; of an
+// adaptive render, the pixels converged too.
 #pragma once
 
 #include <cstdint>
@@ -13,10 +14,13 @@ class ProgressLine {
   explicit ProgressLine(uint64_t total_paths) : total_paths_(total_paths) {}
   ~ProgressLine();
   ProgressFn callback();
+  // An adaptive render's pixels converged so far, of `pixels`: on the line from now on.
+  void converged(uint64_t converged, uint64_t pixels);
 
  private:
   void update(double done, uint64_t rays, double seconds);
   uint64_t total_paths_;
+  uint64_t converged_ = 0, pixels_ = 0;
   double last_draw_ = -1.0;
   bool drawn_ = false;
 };

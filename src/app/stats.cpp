@@ -112,11 +112,13 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   j["settings"][setting(SettingId::Warmup).key] = job.warmup;
   j["settings"][setting(SettingId::WaveSize).key] = job.wave_size;
   j["settings"][setting(SettingId::MegakernelBatch).key] = job.megakernel_batch;
-  j["settings"][setting(SettingId::MinSpp).key] = job.min_spp;
-  if (job.noise_threshold) {
-    // Adaptive sampling: its threshold, and how it ended.
+  j["settings"][setting(SettingId::MinSpp).key] = o.min_spp > 0 ? o.min_spp : job.min_spp;
+  if (o.noise_threshold > 0) {
+    // Adaptive sampling (the job's or the scene's): its threshold, and how it ended.
     const RenderResult& a = o.result;
-    j["adaptive"] = {{"noise_threshold", *job.noise_threshold},
+    j["settings"][setting(SettingId::NoiseThreshold).key] = o.noise_threshold;
+    j["adaptive"] = {{"noise_threshold", o.noise_threshold},
+                     {"min_spp", o.min_spp},
                      {"converged_pixels", a.converged},
                      {"pixels", a.pixel_samples.size()},
                      {"mean_spp", mean_spp(a)},

@@ -1,6 +1,7 @@
 #include "dispatch/renderer.hpp"
 
 #include <algorithm>
+#include <memory>
 #include <string>
 
 #include "cpu/cpu_backend.hpp"
@@ -25,14 +26,19 @@ void check_kernel_runs(const RenderOptions& options) {
   }
 }
 
+// The devices' labels: "cuda:1", "cpu:0", ...
+std::vector<std::string> device_labels(const RenderOptions& options) {
+  std::vector<std::string> labels;
+  for (int d : options.devices) labels.push_back(std::string(backend_name(options.backend)) + ":" + std::to_string(d));
+  return labels;
+}
+
 RenderResult render_on_backend(const Scene& scene, const RenderOptions& options) {
   check_kernel_runs(options);
   const bool gpu = options.backend == Backend::Cuda;
   if (gpu) cuda::check_devices(options);
   if (options.devices.size() <= 1) return gpu ? cuda::render(scene, options) : cpu::render(scene, options);
-  std::vector<std::string> labels;
-  for (int d : options.devices) labels.push_back(std::string(backend_name(options.backend)) + ":" + std::to_string(d));
-  return render_split(options, labels, [&](size_t i) {
+  return render_split(options, device_labels(options), [&](size_t i) {
     return gpu ? cuda::device_renderer(scene, options, i) : cpu::device_renderer(scene, options, i);
   });
 }
@@ -48,36 +54,53 @@ RenderParams default_params(const Scene& scene) { return scene.render; }
 
 namespace {
 
-// Adaptive sampling on the first of the options' devices: its renderer made once
-// (the scene uploaded once), then called for each round of samples.
-RenderResult render_adaptively(const Scene& scene, const RenderOptions& options) {
-  if (options.initial_film || options.after_pass || options.path_feed || options.device_film) {
-    throw InputError("--noise-threshold: not with checkpoints, a resumed render or MPI ranks yet");
-  }
-  if (options.min_spp > options.params.spp) {
-    throw InputError("--min-spp: " + std::to_string(options.min_spp) + " is more than the " +
-                     std::to_string(options.params.spp) + " samples per pixel (--spp, the most a pixel takes)");
-  }
-  check_kernel_runs(options);
-  const bool gpu = options.backend == Backend::Cuda;
-  if (gpu) cuda::check_devices(options);
-  RenderOptions one = options;
-  one.devices = {options.devices.empty() ? 0 : options.devices.front()};
-  const DeviceRenderer device = gpu ? cuda::device_renderer(scene, one, 0) : cpu::device_renderer(scene, one, 0);
-  const int32_t min_spp = options.min_spp > 0 ? options.min_spp : std::min(16, options.params.spp);
-  const double threshold = options.noise_threshold > 0 ? options.noise_threshold : -1.0;
-  one.devices.clear();
-  RenderResult r = render_adaptive(device.render, one, threshold, min_spp);
-  if (options.progress) options.progress(1.0, r.rays, r.seconds);
-  return r;
+// Adaptive sampling on the options' devices, its rounds rendered by `rounds`.
+RenderResult render_adaptively(const Scene& scene, const RenderOptions& options, const AdaptiveHooks& hooks) {
+  return render_adaptive_rounds(adaptive_rounds(scene, options), options, hooks);
 }
 
 }  // namespace
 
-RenderResult render(const Scene& scene, const RenderOptions& options) {
+ChunkRenderer adaptive_rounds(const Scene& scene, const RenderOptions& options) {
+  if (options.initial_film || options.after_pass || options.path_feed || options.device_film) {
+    throw std::logic_error("an adaptive render keeps its checkpoints and ranks through AdaptiveHooks");
+  }
+  check_kernel_runs(options);
+  const bool gpu = options.backend == Backend::Cuda;
+  if (gpu) cuda::check_devices(options);
+  if (options.devices.size() <= 1) {
+    RenderOptions one = options;
+    one.devices = {options.devices.empty() ? 0 : options.devices.front()};
+    auto device = std::make_shared<DeviceRenderer>(gpu ? cuda::device_renderer(scene, one, 0)
+                                                       : cpu::device_renderer(scene, one, 0));
+    return [device](const RenderOptions& round) { return device->render(round); };
+  }
+  auto split = std::make_shared<PixelSplit>(options, device_labels(options), [&](size_t i) {
+    return gpu ? cuda::device_renderer(scene, options, i) : cpu::device_renderer(scene, options, i);
+  });
+  return [split](const RenderOptions& round) { return split->render(round); };
+}
+
+RenderResult render_adaptive_rounds(const ChunkRenderer& rounds, const RenderOptions& options,
+                                    const AdaptiveHooks& hooks) {
+  if (options.min_spp > options.params.spp) {
+    throw InputError("--min-spp: " + std::to_string(options.min_spp) + " is more than the " +
+                     std::to_string(options.params.spp) + " samples per pixel (--spp, the most a pixel takes)");
+  }
+  RenderOptions o = options;
+  o.devices.clear();
+  const double threshold = options.noise_threshold > 0 ? options.noise_threshold : -1.0;
+  RenderResult r = render_adaptive(rounds, o, threshold, resolved_min_spp(options.min_spp, options.params.spp), hooks);
+  if (options.progress) options.progress(1.0, r.rays, r.seconds);
+  return r;
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) { return render(scene, options, AdaptiveHooks{}); }
+
+RenderResult render(const Scene& scene, const RenderOptions& options, const AdaptiveHooks& hooks) {
   if (options.noise_threshold != 0) {
     validate_render(options);
-    return render_adaptively(scene, options);
+    return render_adaptively(scene, options, hooks);
   }
   RenderResult r = render_sums(scene, options);
   take_mean(r);

@@ -2,6 +2,7 @@
 // radiance, counted rays and timings back.
 #pragma once
 
+#include "render/adaptive.hpp"
 #include "render/aovs.hpp"
 #include "render/render_types.hpp"
 #include "render/settings.hpp"
@@ -14,9 +15,20 @@ const char* backend_name(Backend b);
 // Fails with InputError for settings the backend cannot honour (naming the setting),
 // and DeviceError (cuda::CudaError for CUDA calls, naming the call and the stage)
 // when the machine fails. The result holds each pixel's mean radiance. With
-// options.noise_threshold, the render is adaptive (render/adaptive.hpp), on the first
-// of the options' devices.
+// options.noise_threshold, the render is adaptive (render/adaptive.hpp), its rounds'
+// pixels split between the options' devices where it has several.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+// The same, an adaptive render's checkpoints and progress kept by `hooks`.
+RenderResult render(const Scene& scene, const RenderOptions& options, const AdaptiveHooks& hooks);
+// What renders an adaptive render's rounds on the options' devices (each call the
+// pixels and samples its options name, their sums back; render/adaptive.hpp): made
+// once, the scene uploaded to each device once; over several devices, each round's
+// pixels split between them (PixelSplit, dispatch/split.hpp).
+ChunkRenderer adaptive_rounds(const Scene& scene, const RenderOptions& options);
+// The adaptive render of `options` with those rounds (or others that wrap them: an
+// MPI run's ranks), its settings checked first.
+RenderResult render_adaptive_rounds(const ChunkRenderer& rounds, const RenderOptions& options,
+                                    const AdaptiveHooks& hooks);
 // The same render, its result the pixels' sums over the samples it rendered
 // (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
 // sums are added to others' (the ranks of an MPI run).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -383,6 +384,174 @@ class SplitRender {
 RenderResult render_split(const RenderOptions& options, const std::vector<std::string>& labels,
                           const MakeChunkRenderer& make) {
   return SplitRender(options, labels, make).run();
+}
+
+std::vector<SamplePass> weighted_ranges(int32_t first, int32_t count, const std::vector<double>& weights) {
+  std::vector<SamplePass> out;
+  double total = 0;
+  for (double w : weights) total += w;
+  // Cumulative rounding: each boundary is the rounded share of the weights before it,
+  // so the ranges tile [first, first + count) exactly.
+  double before = 0;
+  int32_t at = first;
+  for (size_t r = 0; r < weights.size(); ++r) {
+    before += weights[r];
+    const int32_t end =
+        r + 1 == weights.size() ? first + count : first + static_cast<int32_t>(std::llround(count * (before / total)));
+    out.push_back(SamplePass{at, end - at});
+    at = end;
+  }
+  return out;
+}
+
+// The devices' threads: each makes its renderer, then waits for a round (a new
+// `generation`), renders its run of pixels and reports back; the calling thread
+// hands the rounds out and waits for every device.
+struct PixelSplit::Workers {
+  const RenderOptions options;
+  const std::vector<std::string> labels;
+  std::vector<std::thread> threads;
+  std::mutex mutex;
+  std::condition_variable wake, done;
+  uint64_t generation = 0;
+  size_t finished = 0;
+  bool stop = false;
+  // The round's options and each device's run of pixels and result.
+  const RenderOptions* round = nullptr;
+  std::vector<std::vector<uint32_t>> runs;
+  std::vector<RenderResult> results;
+  std::vector<std::exception_ptr> errors;
+  std::vector<double> speeds;  // pixel-samples a second, of the round before
+
+  Workers(const RenderOptions& o, const std::vector<std::string>& l, const MakeChunkRenderer& make)
+      : options(o), labels(l), runs(l.size()), results(l.size()), errors(l.size()), speeds(l.size(), 1.0) {
+    for (size_t d = 0; d < labels.size(); ++d) threads.emplace_back([this, d, &make] { device(d, make); });
+    // Every device's renderer made (or failed) before the first round.
+    std::unique_lock<std::mutex> lock(mutex);
+    done.wait(lock, [&] { return finished == labels.size(); });
+    finished = 0;
+  }
+
+  ~Workers() {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      stop = true;
+    }
+    wake.notify_all();
+    for (std::thread& t : threads) t.join();
+  }
+
+  void report() {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      ++finished;
+    }
+    done.notify_all();
+  }
+
+  void device(size_t d, const MakeChunkRenderer& make) {
+    std::optional<DeviceRenderer> renderer;
+    try {
+      renderer.emplace(make(d));
+    } catch (...) {
+      errors[d] = std::current_exception();
+    }
+    report();
+    uint64_t seen = 0;
+    for (;;) {
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        wake.wait(lock, [&] { return stop || generation != seen; });
+        if (stop) return;
+        seen = generation;
+      }
+      if (renderer && !runs[d].empty()) {
+        try {
+          RenderOptions o = *round;
+          o.active_pixels = &runs[d];
+          o.devices.clear();
+          results[d] = renderer->render(o);
+        } catch (...) {
+          errors[d] = std::current_exception();
+        }
+      }
+      report();
+    }
+  }
+
+  void rethrow_first_error() {
+    for (size_t d = 0; d < errors.size(); ++d) {
+      if (errors[d]) rethrow_naming(errors[d], labels[d]);
+    }
+  }
+};
+
+PixelSplit::PixelSplit(const RenderOptions& options, const std::vector<std::string>& labels,
+                       const MakeChunkRenderer& make)
+    : workers_(std::make_unique<Workers>(options, labels, make)) {
+  workers_->rethrow_first_error();
+}
+
+PixelSplit::~PixelSplit() = default;
+
+RenderResult PixelSplit::render(const RenderOptions& round) {
+  Workers& w = *workers_;
+  const size_t pixels = static_cast<size_t>(round.params.width) * round.params.height;
+  const size_t listed = round.active_pixels ? round.active_pixels->size() : pixels;
+  const std::vector<SamplePass> cut = weighted_ranges(0, static_cast<int32_t>(listed), w.speeds);
+  for (size_t d = 0; d < cut.size(); ++d) {
+    std::vector<uint32_t>& run = w.runs[d];
+    run.resize(static_cast<size_t>(cut[d].count));
+    for (size_t i = 0; i < run.size(); ++i) {
+      const size_t at = static_cast<size_t>(cut[d].first) + i;
+      run[i] = round.active_pixels ? (*round.active_pixels)[at] : static_cast<uint32_t>(at);
+    }
+    w.results[d] = RenderResult();
+  }
+  const auto start = Clock::now();
+  {
+    std::lock_guard<std::mutex> lock(w.mutex);
+    w.round = &round;
+    ++w.generation;
+  }
+  w.wake.notify_all();
+  {
+    std::unique_lock<std::mutex> lock(w.mutex);
+    w.done.wait(lock, [&] { return w.finished == w.labels.size(); });
+    w.finished = 0;
+  }
+  w.rethrow_first_error();
+  RenderResult out;
+  out.rgb.assign(pixels * 3, 0.0f);
+  out.radiance = Radiance::SumOfSamples;
+  out.samples = round.first_sample + round.sample_count;
+  out.shares.resize(w.labels.size());
+  const uint64_t samples = static_cast<uint64_t>(round.sample_count);
+  for (size_t d = 0; d < w.labels.size(); ++d) {
+    const RenderResult& r = w.results[d];
+    DeviceShare& share = out.shares[d];
+    share.device = w.labels[d];
+    if (w.runs[d].empty()) continue;
+    require_film(r.rgb.size(), pixels * 3, w.labels[d].c_str());
+    // Its pixels' sums, each pixel's whole (no other device rendered it).
+    for (uint32_t p : w.runs[d]) {
+      for (int c = 0; c < 3; ++c) out.rgb[3 * p + c] = r.rgb[3 * p + c];
+    }
+    share.name = r.device;
+    share.chunks = 1;
+    share.paths = r.paths;
+    share.seconds = r.seconds;
+    share.rays = r.rays;
+    share.shadow_rays = r.shadow_rays;
+    out.rays += r.rays;
+    out.shadow_rays += r.shadow_rays;
+    out.paths += r.paths;
+    out.upload_seconds = std::max(out.upload_seconds, r.upload_seconds);
+    if (r.seconds > 0) w.speeds[d] = static_cast<double>(w.runs[d].size()) * static_cast<double>(samples) / r.seconds;
+  }
+  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  out.device = std::to_string(w.labels.size()) + " devices";
+  return out;
 }
 
 }  // namespace wt

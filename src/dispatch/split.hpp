@@ -15,8 +15,11 @@
 // each device (render/device_renderer.hpp); no backend calls it.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "render/passes.hpp"
 
 #include "render/device_renderer.hpp"
 #include "render/render_types.hpp"
@@ -38,5 +41,31 @@ constexpr int kMinChunks = 10;
 // error, named after the device; no partial result is returned.
 RenderResult render_split(const RenderOptions& options, const std::vector<std::string>& labels,
                           const MakeChunkRenderer& make);
+
+// [first, first + count) cut into one range for each weight, in order, each of a size
+// in proportion to its weight (rounded so that the ranges tile it exactly).
+std::vector<SamplePass> weighted_ranges(int32_t first, int32_t count, const std::vector<double>& weights);
+
+// The devices of one adaptive render (render/adaptive.hpp), kept ready across its
+// rounds: each on a thread of its own, with the renderer `make` made there (its
+// scene uploaded once). Each round cuts the pixels it names (options.active_pixels,
+// or every pixel) into one run of consecutive pixels for each device, in proportion
+// to the devices' speeds in the round before (equal at first), renders the runs at
+// once and returns the sums of every pixel (Radiance::SumOfSamples) with each
+// device's share. A pixel's samples are all rendered by one device, in the order one
+// device renders them, so that the image is the one-device image whatever the cut.
+// A device that fails fails the round, with its error named after the device.
+class PixelSplit {
+ public:
+  PixelSplit(const RenderOptions& options, const std::vector<std::string>& labels, const MakeChunkRenderer& make);
+  ~PixelSplit();
+  PixelSplit(const PixelSplit&) = delete;
+  PixelSplit& operator=(const PixelSplit&) = delete;
+  RenderResult render(const RenderOptions& round);
+
+ private:
+  struct Workers;
+  std::unique_ptr<Workers> workers_;
+};
 
 }  // namespace wt

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
 
 namespace wt {
 
@@ -66,28 +67,66 @@ using Clock = std::chrono::steady_clock;
 
 }  // namespace
 
+AdaptiveState AdaptiveState::start(size_t pixels) {
+  AdaptiveState s;
+  s.half_a.assign(pixels * 3, 0.0f);
+  s.half_b.assign(pixels * 3, 0.0f);
+  s.n_a.assign(pixels, 0);
+  s.n_b.assign(pixels, 0);
+  s.converged.assign(pixels, 0);
+  return s;
+}
+
+std::string AdaptiveState::check(size_t pixels, int32_t spp) const {
+  if (half_a.size() != pixels * 3 || half_b.size() != pixels * 3 || n_a.size() != pixels || n_b.size() != pixels ||
+      converged.size() != pixels) {
+    return "its adaptive state is not of " + std::to_string(pixels) + " pixels";
+  }
+  if (samples < 0 || samples > spp) return "its adaptive samples " + std::to_string(samples) + " lie outside 0..spp";
+  for (size_t p = 0; p < pixels; ++p) {
+    const int64_t n = static_cast<int64_t>(n_a[p]) + n_b[p];
+    const bool counts_fit = n_a[p] >= 0 && n_b[p] >= 0 && n <= samples && (converged[p] ? true : n == samples);
+    if (!counts_fit || converged[p] > 1) {
+      return "pixel " + std::to_string(p) + "'s adaptive counts (" + std::to_string(n_a[p]) + ", " +
+             std::to_string(n_b[p]) + ") do not fit its " + std::to_string(samples) + " samples";
+    }
+    for (int c = 0; c < 3; ++c) {
+      const float a = half_a[3 * p + c], b = half_b[3 * p + c];
+      if (!(std::isfinite(a) && std::isfinite(b) && a >= 0.0f && b >= 0.0f)) {
+        return "pixel " + std::to_string(p) + "'s halves hold a sum that is not a finite radiance";
+      }
+    }
+  }
+  return "";
+}
+
+int32_t resolved_min_spp(int32_t min_spp, int32_t spp) { return min_spp > 0 ? min_spp : std::min(16, spp); }
+
 RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& options, double threshold,
-                             int32_t min_spp) {
+                             int32_t min_spp, const AdaptiveHooks& hooks) {
   const RenderParams& rp = options.params;
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   // Each half's sums: the rounds' films added on the host.
-  std::vector<float> half_a(pixels * 3, 0.0f), half_b(pixels * 3, 0.0f);
-  std::vector<int32_t> n_a(pixels, 0), n_b(pixels, 0);
-  std::vector<uint8_t> done(pixels, 0);
+  AdaptiveState st = hooks.resume ? *hooks.resume : AdaptiveState::start(pixels);
   auto halves_of = [&](size_t p) {
-    return PixelHalves{{half_a[3 * p], half_a[3 * p + 1], half_a[3 * p + 2]},
-                       {half_b[3 * p], half_b[3 * p + 1], half_b[3 * p + 2]},
-                       n_a[p],
-                       n_b[p]};
+    return PixelHalves{{st.half_a[3 * p], st.half_a[3 * p + 1], st.half_a[3 * p + 2]},
+                       {st.half_b[3 * p], st.half_b[3 * p + 1], st.half_b[3 * p + 2]},
+                       st.n_a[p],
+                       st.n_b[p]};
   };
-  std::vector<uint32_t> active(pixels);
-  for (size_t p = 0; p < pixels; ++p) active[p] = static_cast<uint32_t>(p);
+  std::vector<uint32_t> active;
+  for (size_t p = 0; p < pixels; ++p) {
+    if (!st.converged[p]) active.push_back(static_cast<uint32_t>(p));
+  }
 
   RenderResult out;
   const auto t0 = Clock::now();
-  int32_t n = 0;  // the samples every active pixel has
+  int32_t& n = st.samples;  // the samples every active pixel has
   const int32_t first_step = std::min(std::max(min_spp, 2), rp.spp);
-  // Rendered paths over all the render could take (progress's fraction).
+  // Rendered paths over all the render could take (progress's fraction), from where
+  // it starts.
+  uint64_t paths_before = 0;
+  for (size_t p = 0; p < pixels; ++p) paths_before += static_cast<uint64_t>(st.n_a[p]) + st.n_b[p];
   const double all_paths = static_cast<double>(pixels) * rp.spp;
   auto round = [&](int32_t count, bool into_a) {
     if (count <= 0 || active.empty()) return;
@@ -100,8 +139,8 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
     o.initial_film = nullptr;
     o.warmup = 0;
     const RenderResult r = render(o);
-    std::vector<float>& half = into_a ? half_a : half_b;
-    std::vector<int32_t>& counts = into_a ? n_a : n_b;
+    std::vector<float>& half = into_a ? st.half_a : st.half_b;
+    std::vector<int32_t>& counts = into_a ? st.n_a : st.n_b;
     for (uint32_t p : active) {
       for (int c = 0; c < 3; ++c) half[3 * p + c] += r.rgb[3 * p + c];
       counts[p] += count;
@@ -112,9 +151,21 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
     out.seconds += r.seconds;
     out.upload_seconds = r.upload_seconds;
     out.device = r.device;
+    // Of a render split over devices: each device's part of the rounds.
+    if (out.shares.size() < r.shares.size()) out.shares.resize(r.shares.size());
+    for (size_t d = 0; d < r.shares.size(); ++d) {
+      DeviceShare& s = out.shares[d];
+      s.device = r.shares[d].device;
+      s.name = r.shares[d].name;
+      s.chunks += r.shares[d].chunks;
+      s.paths += r.shares[d].paths;
+      s.seconds += r.shares[d].seconds;
+      s.rays += r.shares[d].rays;
+      s.shadow_rays += r.shares[d].shadow_rays;
+    }
     n += count;
     if (options.progress) {
-      options.progress(std::min(1.0, static_cast<double>(out.paths) / all_paths), out.rays,
+      options.progress(std::min(1.0, (paths_before + static_cast<double>(out.paths)) / all_paths), out.rays,
                        std::chrono::duration<double>(Clock::now() - t0).count());
     }
   };
@@ -128,7 +179,8 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
     o.warmup = 0;
     render(o);
   }
-  for (int32_t step = first_step; step > 0 && !active.empty(); step = step_samples(n, min_spp, rp.spp)) {
+  int32_t step = n == 0 ? first_step : step_samples(n, min_spp, rp.spp);
+  for (; step > 0 && !active.empty(); step = step_samples(n, min_spp, rp.spp)) {
     const int32_t a = step / 2, b = step - step / 2;
     round(a, true);
     round(b, false);
@@ -139,27 +191,38 @@ RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& o
     std::vector<uint32_t> going;
     for (uint32_t p : active) {
       if (now[p]) {
-        done[p] = 1;
+        st.converged[p] = 1;
       } else {
         going.push_back(p);
       }
     }
     active = std::move(going);
+    if (hooks.converged) {
+      uint64_t done = 0;
+      for (uint8_t c : st.converged) done += c;
+      hooks.converged(done);
+    }
+    const bool last = step_samples(n, min_spp, rp.spp) == 0 || active.empty();
+    if (hooks.after_step && !hooks.after_step(st, last) && !last) {
+      out.interrupted = true;
+      break;
+    }
   }
 
   out.rgb.assign(pixels * 3, 0.0f);
   out.variance.assign(pixels * 3, 0.0f);
   out.pixel_samples.assign(pixels, 0);
   for (size_t p = 0; p < pixels; ++p) {
-    const int32_t count = n_a[p] + n_b[p];
+    const int32_t count = st.n_a[p] + st.n_b[p];
     out.pixel_samples[p] = count;
     double v[3];
     mean_variance(halves_of(p), v);
     for (int c = 0; c < 3; ++c) {
-      out.rgb[3 * p + c] = count > 0 ? static_cast<float>((half_a[3 * p + c] + half_b[3 * p + c]) / count) : 0.0f;
+      out.rgb[3 * p + c] =
+          count > 0 ? static_cast<float>((st.half_a[3 * p + c] + st.half_b[3 * p + c]) / count) : 0.0f;
       out.variance[3 * p + c] = static_cast<float>(v[c]);
     }
-    out.converged += done[p];
+    out.converged += st.converged[p];
   }
   out.samples = n;
   out.radiance = Radiance::MeanOfSamples;

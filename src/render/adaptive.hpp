@@ -27,6 +27,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "render/device_renderer.hpp"
@@ -61,13 +63,48 @@ std::vector<uint8_t> converged_pixels(const std::vector<double>& r2, int width, 
 // what spp leaves.
 int32_t step_samples(int32_t n, int32_t min_spp, int32_t spp);
 
-// Renders options.params' image adaptively with `render` (a device's renderer: each
-// call renders the pixels and samples its options name and returns their sums,
-// Radiance::SumOfSamples). The result holds each pixel's mean (MeanOfSamples),
-// `pixel_samples` and `variance` (V of each channel), `converged` (the pixels
-// that stopped before spp), and the rounds' rays, paths and seconds summed.
+// All that decides the rest of an adaptive render, as it stands between two steps
+// (a checkpoint holds it, app/checkpoint.hpp): the samples every pixel still going
+// has, each pixel's halves and whether it has converged. A pixel still going is one
+// not converged; after the last step, none is going.
+struct AdaptiveState {
+  int32_t samples = 0;                // n
+  std::vector<float> half_a, half_b;  // each pixel's sums of its halves, RGB
+  std::vector<int32_t> n_a, n_b;      // their samples
+  std::vector<uint8_t> converged;     // 1: stopped under the threshold
+  // Zeros for `pixels` pixels: the state before the first step.
+  static AdaptiveState start(size_t pixels);
+  // Empty where the sizes disagree with `pixels`, else what is wrong with it (a
+  // checkpoint's is checked so before it is resumed): the halves' sums finite and at
+  // least 0, the counts within 0..samples and adding up to samples for a pixel still
+  // going.
+  std::string check(size_t pixels, int32_t spp) const;
+};
+
+// What an adaptive render tells and asks of its caller besides the image.
+struct AdaptiveHooks {
+  // Continue from this state (a resumed checkpoint's) rather than from the start; the
+  // render then ends as the uninterrupted one does, bit for bit.
+  const AdaptiveState* resume = nullptr;
+  // After each step, with the state and whether it was the last: false stops the
+  // render there (the result then says `interrupted`, and holds the image as far as
+  // it went).
+  std::function<bool(const AdaptiveState&, bool last)> after_step;
+  // After each step: the pixels converged so far (the progress line's).
+  std::function<void(uint64_t converged)> converged;
+};
+
+// Renders options.params' image adaptively with `render` (a device's renderer, or
+// several devices' split by pixels: each call renders the pixels and samples its
+// options name and returns their sums, Radiance::SumOfSamples). The result holds
+// each pixel's mean (MeanOfSamples), `pixel_samples` and `variance` (V of each
+// channel), `converged` (the pixels that stopped before spp), and the rounds' rays,
+// paths and seconds summed.
 RenderResult render_adaptive(const ChunkRenderer& render, const RenderOptions& options, double threshold,
-                             int32_t min_spp);
+                             int32_t min_spp, const AdaptiveHooks& hooks = {});
+
+// min_spp as a render takes it: 0 chooses 16, or spp where less.
+int32_t resolved_min_spp(int32_t min_spp, int32_t spp);
 
 // The mean of an adaptive result's pixel_samples (0 where it has none).
 double mean_spp(const RenderResult& r);

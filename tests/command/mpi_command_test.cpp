@@ -125,6 +125,26 @@ TEST_F(MpiCommand, RanksOnTheCpuRenderTheOneProcessImage) {
   }
 }
 
+// An adaptive render over ranks: rank 0 decides each round, every rank renders its
+// run of the pixels still going, each pixel's samples on one rank alone: the image,
+// each pixel's samples and the rays are the one process's, bit for bit.
+TEST_F(MpiCommand, AnAdaptiveRenderOverRanksIsTheOneProcessRender) {
+  const std::string options = "'" + (fs::current_path() / "scenes" / "seed57.json").string() +
+                              "' --backend cpu --width 48 --height 27 --spp 128 --threads 1 -q --noise-threshold 0.05"
+                              " --min-spp 8 --aov spp";
+  ASSERT_EQ(shell("{W} render " + options + " -o one.pfm --stats one.json"), 0) << err_;
+  ASSERT_EQ(shell("mpirun -n 3 {W} render " + options + " -o three.pfm --stats three.json"), 0) << err_;
+  EXPECT_EQ(read(path("one.pfm")), read(path("three.pfm")));
+  EXPECT_EQ(read(path("one.spp.pfm")), read(path("three.spp.pfm")));
+  const json one = json::parse(read(path("one.json"))), three = json::parse(read(path("three.json")));
+  EXPECT_EQ(three["rays"], one["rays"]);
+  EXPECT_EQ(three["adaptive"]["converged_pixels"], one["adaptive"]["converged_pixels"]);
+  EXPECT_GT(one["adaptive"]["converged_pixels"].get<int>(), 0);
+  EXPECT_EQ(three["ranks"], 3);
+  ASSERT_EQ(three["devices"].size(), 3u) << three.dump(2);
+  for (size_t r = 0; r < 3; ++r) EXPECT_GT(three["devices"][r]["paths"].get<uint64_t>(), 0u) << three.dump(2);
+}
+
 TEST_F(MpiCommand, AFailingRankFailsTheRunSayingWhichAndWhyAndNoImageIsWritten) {
   const std::string options = scene_and_options() + " -o out.png";
   // Rank 2's scene is missing (as on a host without the file).
