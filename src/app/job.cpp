@@ -609,9 +609,11 @@ void print_outcome(const Job& job, const JobOutcome& o) {
                  r.samples);
   }
   for (const DeviceShare& s : r.shares) {
-    // Chunks of samples, or (a wavefront's devices sharing the paths) blocks of paths.
+    // Chunks of samples, or (a wavefront's devices sharing the paths) blocks of paths,
+    // or an adaptive render's rounds (a run of their pixels each).
     std::fprintf(stderr, "  %s (%s): %.1f spp in %d %s, %.3f s, %.1f M rays/s\n", s.device.c_str(), s.name.c_str(),
-                 pixels > 0 ? s.paths / pixels : 0.0, s.chunks, s.samples > 0 ? "chunks" : "blocks of paths",
+                 pixels > 0 ? s.paths / pixels : 0.0, s.chunks,
+                 o.noise_threshold != 0 ? "rounds" : s.samples > 0 ? "chunks" : "blocks of paths",
                  s.seconds, s.seconds > 0 ? s.rays / s.seconds / 1e6 : 0.0);
   }
 }
