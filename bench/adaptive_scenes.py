@@ -89,8 +89,9 @@ def pictures(out, scene_name, size):
     row = panels[0]
     for p in panels[1:]:
         row = np.concatenate([row, gap, p], axis=1)
-    os.makedirs(os.path.join(out, "..", "pictures"), exist_ok=True)
-    Image.fromarray(row).save(os.path.join(out, "..", "pictures", scene_name + ".png"), optimize=True)
+    folder = os.path.join(out, "..", "..", "pictures")  # OUT_DIR/pictures
+    os.makedirs(folder, exist_ok=True)
+    Image.fromarray(row).save(os.path.join(folder, scene_name + ".png"), optimize=True)
     return "ok"
 
 

@@ -170,7 +170,7 @@ Round read_round(const std::string& m) {
   const size_t head = 1 + 2 * sizeof(int32_t);
   r.listed = m.size() > head;
   r.pixels.resize((m.size() - head) / sizeof(uint32_t));
-  std::memcpy(r.pixels.data(), m.data() + head, r.pixels.size() * sizeof(uint32_t));
+  if (!r.pixels.empty()) std::memcpy(r.pixels.data(), m.data() + head, r.pixels.size() * sizeof(uint32_t));
   return r;
 }
 
