@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -150,6 +151,32 @@ TEST_F(MitsubaXml, PropertiesAreTyped) {
   EXPECT_EQ(e.find("intensity")->line, 4);
 }
 
+// Wavelength:value pairs become linear sRGB (spectrum_to_rgb): a flat spectrum is its
+// grey, and narrow bands are red, green and blue where the eye sees them so.
+TEST_F(MitsubaXml, SpectraOfPairsBecomeTheirColour) {
+  const std::string path = write("s.xml", R"(<scene version="3.0.0">
+  <bsdf type="diffuse">
+    <spectrum name="flat" value="360:0.5, 830:0.5"/>
+    <spectrum name="red" value="600:0, 620:1, 640:0"/>
+    <spectrum name="green" value="520:0, 540:1, 560:0"/>
+    <spectrum name="blue" value="440:0, 455:1, 470:0"/>
+  </bsdf>
+</scene>)");
+  const auto scene = read_scene_xml(path);
+  const Object& b = *scene->children[0];
+  const Rgb flat = value_of<Rgb>(b, "flat");
+  EXPECT_NEAR(flat.r, 0.5, 1e-9);
+  EXPECT_NEAR(flat.g, 0.5, 1e-9);
+  EXPECT_NEAR(flat.b, 0.5, 1e-9);
+  const Rgb red = value_of<Rgb>(b, "red"), green = value_of<Rgb>(b, "green"), blue = value_of<Rgb>(b, "blue");
+  EXPECT_GT(red.r, 4 * std::max(red.g, red.b));
+  EXPECT_GT(green.g, 2 * std::max(green.r, green.b));
+  EXPECT_GT(blue.b, 4 * std::max(blue.r, blue.g));
+  // Linear in the spectrum: twice the values, twice the colour.
+  const Rgb twice = spectrum_to_rgb({{600, 0}, {620, 2}, {640, 0}});
+  EXPECT_NEAR(twice.r, 2 * red.r, 1e-12);
+}
+
 // Each thing wrong is one line: the file, the line, the element and what is wrong.
 TEST_F(MitsubaXml, EveryErrorNamesTheFileTheLineAndTheElement) {
   const std::string header = "<scene version=\"3.0.0\">\n";
@@ -167,8 +194,12 @@ TEST_F(MitsubaXml, EveryErrorNamesTheFileTheLineAndTheElement) {
       {header + "  <integer name=\"n\" value=\"2.5\"/>\n</scene>", ":2: integer: '2.5' is not an integer"},
       {header + "  <boolean name=\"b\" value=\"yes\"/>\n</scene>", ":2: boolean: 'yes' is neither true nor false"},
       {header + "  <float name=\"f\" value=\"abc\"/>\n</scene>", ":2: float: 'abc' is not a list of numbers"},
-      {header + "  <spectrum name=\"s\" value=\"400:0.1, 700:0.5\"/>\n</scene>",
-       ":2: spectrum: wavelength:value pairs are not read yet; give one value (a grey) or an <rgb>"},
+      {header + "  <spectrum name=\"s\" value=\"700:0.1, 400:0.5\"/>\n</scene>",
+       ":2: spectrum: the wavelengths must rise ('700:0.1, 400:0.5')"},
+      {header + "  <spectrum name=\"s\" value=\"400:0.1, 500\"/>\n</scene>",
+       ":2: spectrum: '500' is not a wavelength:value pair"},
+      {header + "  <spectrum name=\"s\" value=\"400:0.1\"/>\n</scene>",
+       ":2: spectrum: a spectrum of wavelength:value pairs needs two at least"},
       {header + "  <widget name=\"w\"/>\n</scene>",
        ":2: widget: unknown element (expected a plugin object, a property, default, include or ref)"},
       {header + "  <bsdf type=\"diffuse\">\n</scene>", ":3: xml: malformed XML ("},

@@ -38,6 +38,52 @@ const Property* Object::find(const std::string& property) const {
   return nullptr;
 }
 
+Rgb spectrum_to_rgb(const std::vector<std::pair<double, double>>& samples) {
+  // The CIE 1931 2-degree colour matching functions by the multi-lobe Gaussian fit of
+  // Wyman, Sloan and Shirley (JCGT 2(2), 2013), each lobe of width s1 below its mean
+  // and s2 above it.
+  const auto lobe = [](double l, double mean, double s1, double s2) {
+    const double t = (l - mean) / (l < mean ? s1 : s2);
+    return std::exp(-0.5 * t * t);
+  };
+  const auto cmf = [&](double l) {
+    return std::array<double, 3>{
+        1.056 * lobe(l, 599.8, 37.9, 31.0) + 0.362 * lobe(l, 442.0, 16.0, 26.7) - 0.065 * lobe(l, 501.1, 20.4, 26.2),
+        0.821 * lobe(l, 568.8, 46.9, 40.5) + 0.286 * lobe(l, 530.9, 16.3, 31.1),
+        1.217 * lobe(l, 437.0, 11.8, 36.0) + 0.681 * lobe(l, 459.0, 26.0, 13.8)};
+  };
+  // The spectrum between its samples, linear; 0 outside them.
+  const auto value = [&](double l) {
+    if (l < samples.front().first || l > samples.back().first) return 0.0;
+    for (size_t i = 1; i < samples.size(); ++i) {
+      if (l <= samples[i].first) {
+        const double t = (l - samples[i - 1].first) / (samples[i].first - samples[i - 1].first);
+        return samples[i - 1].second + t * (samples[i].second - samples[i - 1].second);
+      }
+    }
+    return samples.back().second;
+  };
+  // Linear sRGB of XYZ (IEC 61966-2-1's matrix).
+  const auto srgb = [](const std::array<double, 3>& c) {
+    return std::array<double, 3>{3.2404542 * c[0] - 1.5371385 * c[1] - 0.4985314 * c[2],
+                                 -0.9692660 * c[0] + 1.8760108 * c[1] + 0.0415560 * c[2],
+                                 0.0556434 * c[0] - 0.2040259 * c[1] + 1.0572252 * c[2]};
+  };
+  std::array<double, 3> xyz{}, white{};
+  for (double l = 360.5; l < 830.0; l += 1.0) {  // 1 nm steps over 360..830 nm
+    const std::array<double, 3> c = cmf(l);
+    const double v = value(l);
+    for (int k = 0; k < 3; ++k) {
+      xyz[k] += v * c[k];
+      white[k] += c[k];
+    }
+  }
+  const std::array<double, 3> rgb = srgb(xyz), one = srgb(white);
+  // Each channel over that of the constant spectrum 1, so that a flat spectrum is
+  // exactly its grey.
+  return {rgb[0] / one[0], rgb[1] / one[1], rgb[2] / one[2]};
+}
+
 namespace {
 
 // The plugin objects' tags; every other element is a property, a transform's
@@ -166,6 +212,28 @@ class Reader {
     return out;
   }
 
+  // "wavelength:value, ..." in nanometres, the wavelengths rising, at least two.
+  std::vector<std::pair<double, double>> pairs(const Where& at, const std::string& element, const std::string& text) {
+    std::vector<std::pair<double, double>> out;
+    size_t start = 0;
+    while (start < text.size()) {
+      size_t end = text.find(',', start);
+      if (end == std::string::npos) end = text.size();
+      std::string item = text.substr(start, end - start);
+      start = end + 1;
+      const size_t first = item.find_first_not_of(" \t\r\n");
+      if (first == std::string::npos) continue;
+      item = item.substr(first, item.find_last_not_of(" \t\r\n") - first + 1);
+      const size_t colon = item.find(':');
+      if (colon == std::string::npos) fail(at, element, "'" + item + "' is not a wavelength:value pair");
+      const double l = number(at, element, item.substr(0, colon)), v = number(at, element, item.substr(colon + 1));
+      if (!out.empty() && !(l > out.back().first)) fail(at, element, "the wavelengths must rise ('" + text + "')");
+      out.emplace_back(l, v);
+    }
+    if (out.size() < 2) fail(at, element, "a spectrum of wavelength:value pairs needs two at least");
+    return out;
+  }
+
   double number(const Where& at, const std::string& element, const std::string& text) {
     const std::vector<double> v = numbers(at, element, text);
     if (v.size() != 1) fail(at, element, "'" + text + "' is not one number");
@@ -283,11 +351,12 @@ class Reader {
       }
     } else if (kind == "spectrum") {
       const std::string text = attribute(doc, node, "value");
-      if (text.find(':') != std::string::npos) {
-        fail(at, kind, "wavelength:value pairs are not read yet; give one value (a grey) or an <rgb>");
+      if (text.find(':') == std::string::npos) {
+        const double v = number(at, kind, text);
+        p.value = Rgb{v, v, v};
+      } else {
+        p.value = spectrum_to_rgb(pairs(at, kind, text));
       }
-      const double v = number(at, kind, text);
-      p.value = Rgb{v, v, v};
     } else if (kind == "point" || kind == "vector") {
       p.value = vec3(doc, node, 0.0, false);
     } else if (kind == "transform") {

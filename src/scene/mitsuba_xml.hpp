@@ -11,7 +11,8 @@
 // - `id` attributes name objects; `<ref id name>` puts the named object where it
 //   stands (an unknown id, or an id given twice, is an error);
 // - properties: `<float>`, `<integer>`, `<boolean>`, `<string>`, `<rgb>` (one value or
-//   three), `<spectrum>` (one value: a grey), `<point>` and `<vector>` (`value` or
+//   three), `<spectrum>` (one value: a grey; or wavelength:value pairs, reduced to
+//   RGB by spectrum_to_rgb), `<point>` and `<vector>` (`value` or
 //   `x`, `y`, `z`), and `<transform>` whose children (`translate`, `rotate`, `scale`,
 //   `matrix`, `lookat`) each multiply the matrix from the left, in the order given;
 // - every error is one InputError "<file>:<line>: <element>: <what>".
@@ -39,6 +40,14 @@ struct Vec3 {
 };
 
 using Value = std::variant<double, int64_t, bool, std::string, Rgb, Vec3, Matrix>;
+
+// A spectrum given as (wavelength in nm, value) samples, rising, read linearly between
+// them and 0 outside, as linear sRGB: integrated over 360..830 nm against the CIE 1931
+// colour matching functions (Wyman, Sloan and Shirley's analytic fit), taken to sRGB,
+// and each channel divided by that of the constant spectrum 1, so that a flat
+// spectrum over 360..830 nm is its grey. (A reflectance's colour under an
+// equal-energy white; Mitsuba's own reduction may weigh an emitter's by D65.)
+Rgb spectrum_to_rgb(const std::vector<std::pair<double, double>>& samples);
 
 struct Property {
   std::string name;
