@@ -375,7 +375,8 @@ const char* kSpec = R"({"warmup": 0, "repeats": 5, "check_spp": 1, "check_bound"
      "configs": [{"width": 64, "height": 32, "spp": 2, "depth": 5},
                  {"width": 8, "height": 8, "spp": 1, "depth": 9, "roulette_depth": 3, "seed": 4294967295}]},
     {"name": "b", "scene": "t.json", "kernels": ["wavefront-unsorted"],
-     "configs": [{"width": 16, "height": 16, "spp": 4, "depth": 2}]}]})";
+     "configs": [{"width": 16, "height": 16, "spp": 4, "depth": 2},
+                 {"width": 16, "height": 16, "spp": 64, "depth": 2, "noise_threshold": 0.05, "min_spp": 8}]}]})";
 
 TEST_F(JobTest, BenchSpecIsReadWithItsDefaults) {
   std::string spec = write("spec.json", kSpec);
@@ -384,7 +385,10 @@ TEST_F(JobTest, BenchSpecIsReadWithItsDefaults) {
   EXPECT_EQ(s.repeats, 5);
   EXPECT_EQ(s.check_spp, 1);
   EXPECT_DOUBLE_EQ(s.check_bound, 0.01);
-  ASSERT_EQ(s.points.size(), 3u);
+  ASSERT_EQ(s.points.size(), 4u);
+  EXPECT_EQ(s.points[0].noise_threshold, 0.0);
+  EXPECT_EQ(s.points[3].noise_threshold, 0.05);
+  EXPECT_EQ(s.points[3].min_spp, 8);
   const BenchPoint& p0 = s.points[0];
   EXPECT_EQ(p0.group, "a");
   EXPECT_EQ(p0.scene, path("scenes/s.json"));  // relative to the spec's folder
@@ -398,9 +402,39 @@ TEST_F(JobTest, BenchSpecIsReadWithItsDefaults) {
   EXPECT_EQ(s.points[1].params.roulette_depth, 3);
   EXPECT_EQ(s.points[1].params.seed, 4294967295u);
   BenchSpec only_b = read_bench_spec(spec, "b");
-  ASSERT_EQ(only_b.points.size(), 1u);
+  ASSERT_EQ(only_b.points.size(), 2u);
   EXPECT_EQ(only_b.points[0].kernels, std::vector<std::string>{"wavefront-unsorted"});
   EXPECT_EQ(error_of([&] { read_bench_spec(spec, "c"); }), spec + ": no points to run in group c");
+}
+
+// A config with a noise threshold times the kernels' adaptive renders, each row
+// saying what they took: the same samples for every kernel of the CPU backend.
+TEST_F(JobTest, ABenchConfigWithANoiseThresholdTimesAdaptiveRenders) {
+  const std::string spec = write("adaptive.json", R"({"warmup": 0, "repeats": 1, "check_spp": 1,
+    "groups": [{"name": "a", "scene": ")" + test::repo_path("scenes/quick.json") + R"(",
+      "kernels": ["megakernel", "wavefront"],
+      "configs": [{"width": 24, "height": 16, "spp": 128, "depth": 4, "noise_threshold": 0.1, "min_spp": 8}]}]})");
+  BenchOptions o;
+  o.spec = spec;
+  o.out_dir = path("out");
+  o.backend = "cpu";
+  ASSERT_EQ(run_bench(o), 0);
+  std::ifstream f(path("out/results.json"));
+  const nlohmann::json results = nlohmann::json::parse(f);
+  ASSERT_EQ(results["points"].size(), 2u);
+  for (const nlohmann::json& row : results["points"]) {
+    SCOPED_TRACE(row["kernel"].get<std::string>());
+    EXPECT_EQ(row["status"], "ok");
+    EXPECT_EQ(row["noise_threshold"], 0.1);
+    EXPECT_EQ(row["min_spp"], 8);
+    EXPECT_GE(row["mean_spp"].get<double>(), 8.0);
+    EXPECT_LT(row["mean_spp"].get<double>(), 128.0);
+    EXPECT_EQ(row["mean_spp"], results["points"][0]["mean_spp"]);
+  }
+  std::ifstream csv(path("out/results.csv"));
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_NE(header.find(",noise_threshold,mean_spp"), std::string::npos) << header;
 }
 
 TEST_F(JobTest, BenchSpecMistakesNameTheirPath) {
@@ -414,7 +448,13 @@ TEST_F(JobTest, BenchSpecMistakesNameTheirPath) {
   const std::string spec = path("spec.json");
   EXPECT_EQ(error_with("\"roulette_depth\": 3", "\"roulete_depth\": 3"),
             spec + ": /groups/0/configs/1/roulete_depth: unknown key (expected width, height, spp, depth, "
-                   "roulette_depth, seed, nee)");
+                   "roulette_depth, seed, nee, min_spp, noise_threshold)");
+  EXPECT_EQ(error_with("\"noise_threshold\": 0.05", "\"noise_threshold\": 0"),
+            spec + ": /groups/1/configs/1/noise_threshold: must be above 0 and at most 1 (got 0)");
+  EXPECT_EQ(error_with("\"noise_threshold\": 0.05, ", ""),
+            spec + ": /groups/1/configs/1/min_spp: adaptive sampling's first samples: give noise_threshold too");
+  EXPECT_EQ(error_with("\"min_spp\": 8", "\"min_spp\": 80"),
+            spec + ": /groups/1/configs/1/min_spp: more than the config's spp");
   EXPECT_EQ(error_with("\"wavefront\"]", "\"wavefrnt\"]"),
             spec + ": /groups/0/kernels/1: unknown value 'wavefrnt' (expected megakernel, megakernel-constant, "
                    "wavefront, wavefront-sorted, wavefront-unsorted)");

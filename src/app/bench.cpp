@@ -1,5 +1,7 @@
 #include "app/bench.hpp"
 
+#include "render/adaptive.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -15,6 +17,7 @@
 #include "build_info.hpp"
 #include "device/device.hpp"
 #include "errors/errors.hpp"
+#include "render/adaptive.hpp"
 #include "render/settings.hpp"
 #include "scene/json_reader.hpp"
 
@@ -38,7 +41,7 @@ BenchSpec read_bench_spec(const std::string& path, const std::string& only) {
   const JsonPath groups_path = top / "groups";
   const json& groups = r.array(r.required(doc, top, "groups"), groups_path);
   std::vector<std::string> config_keys;
-  for (SettingId id : render_settings()) config_keys.push_back(setting(id).key);
+  for (SettingId id : scene_settings()) config_keys.push_back(setting(id).key);
   for (size_t g = 0; g < groups.size(); ++g) {
     const JsonPath gp = groups_path / g;
     r.check_keys(groups[g], gp, {"name", "scene", "kernels", "configs"});
@@ -67,6 +70,16 @@ BenchSpec read_bench_spec(const std::string& path, const std::string& only) {
         }
       }
       if (p.params.roulette_depth < 0) p.params.roulette_depth = p.params.depth;
+      const char* threshold = setting(SettingId::NoiseThreshold).key;
+      const char* min_spp = setting(SettingId::MinSpp).key;
+      if (configs[c].contains(threshold)) {
+        p.noise_threshold = r.real_setting(configs[c][threshold], at / threshold, SettingId::NoiseThreshold);
+      }
+      if (configs[c].contains(min_spp)) {
+        if (p.noise_threshold == 0) r.fail_at(at / min_spp, "adaptive sampling's first samples: give noise_threshold too");
+        p.min_spp = static_cast<int32_t>(r.integer_setting(configs[c][min_spp], at / min_spp, SettingId::MinSpp));
+        if (p.min_spp > p.params.spp) r.fail_at(at / min_spp, "more than the config's spp");
+      }
       try {
         validate_params(p.params);
       } catch (const InputError& e) {
@@ -157,6 +170,13 @@ void time_kernel(const Scene& scene, RenderOptions o, const BenchSpec& spec, jso
   row["seconds_min"] = *std::min_element(seconds.begin(), seconds.end());
   row["seconds_max"] = *std::max_element(seconds.begin(), seconds.end());
   add_measurements(row, kept, med, scene.load_times);
+  if (o.noise_threshold > 0) {
+    // The timed run's adaptive sampling: what it took and how far it converged.
+    row["noise_threshold"] = o.noise_threshold;
+    row["min_spp"] = resolved_min_spp(o.min_spp, o.params.spp);
+    row["mean_spp"] = mean_spp(kept);
+    row["converged_pixels"] = kept.converged;
+  }
   row["geometry"] = geometry_json(scene.summary());
   for (const StageTime& st : kept.stages) {
     if (std::find(stages.begin(), stages.end(), st.name) == stages.end()) stages.push_back(st.name);
@@ -185,6 +205,8 @@ bool bench_kernel(const Scene& scene, const BenchPoint& p, const std::string& kn
       return false;
     }
     o.params = p.params;
+    o.noise_threshold = p.noise_threshold;
+    o.min_spp = p.min_spp;
     time_kernel(scene, o, spec, row, stages, diff);
     return true;
   } catch (const std::exception& e) {
@@ -198,7 +220,7 @@ bool bench_kernel(const Scene& scene, const BenchPoint& p, const std::string& kn
 std::string results_csv(const json& results) {
   std::ostringstream csv;
   csv << "group,scene,width,height,spp,depth,kernel,status,seconds_median,seconds_min,seconds_max,rays,paths,"
-         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff,shadow_rays\n";
+         "m_rays_per_s,m_paths_per_s,rays_per_path,check_mean_abs_diff,shadow_rays,noise_threshold,mean_spp\n";
   for (const json& r : results["points"]) {
     csv << r["group"].get<std::string>() << "," << fs::path(r["scene"].get<std::string>()).filename().string() << ","
         << r["width"] << "," << r["height"] << "," << r["spp"] << "," << r["depth"] << ","
@@ -208,7 +230,8 @@ std::string results_csv(const json& results) {
         << r.value("m_rays_per_s", 0.0) << "," << r.value("m_paths_per_s", 0.0) << ","
         << r.value("rays_per_path", 0.0) << ","
         << (r.contains("check") ? r["check"]["mean_abs_diff"].get<double>() : -1.0) << ","
-        << r.value("shadow_rays", uint64_t(0)) << "\n";
+        << r.value("shadow_rays", uint64_t(0)) << "," << r.value("noise_threshold", 0.0) << ","
+        << r.value("mean_spp", 0.0) << "\n";
   }
   return csv.str();
 }
@@ -243,9 +266,10 @@ int run_bench(const BenchOptions& options) {
       row["group"] = p.group;
       row["scene"] = p.scene;
       row["kernel"] = kname;
-      std::fprintf(stderr, "[%zu/%zu] %s %s %dx%d %d spp depth %d %s\n", done, total, p.group.c_str(),
+      if (p.noise_threshold > 0) row["noise_threshold"] = p.noise_threshold;
+      std::fprintf(stderr, "[%zu/%zu] %s %s %dx%d %d spp depth %d %s%s\n", done, total, p.group.c_str(),
                    fs::path(p.scene).filename().c_str(), p.params.width, p.params.height, p.params.spp,
-                   p.params.depth, kname.c_str());
+                   p.params.depth, kname.c_str(), p.noise_threshold > 0 ? " adaptive" : "");
       if (!bench_kernel(scene, p, kname, check, reference, spec, row, stages)) ++failures;
       results["points"].push_back(row);
     }

@@ -27,6 +27,10 @@ struct BenchPoint {
   std::string group, scene;
   RenderParams params{};
   std::vector<std::string> kernels;
+  // Adaptive sampling (render/adaptive.hpp): a threshold above 0 times the kernels'
+  // adaptive renders (params.spp the most a pixel takes); min_spp 0 chooses.
+  double noise_threshold = 0;
+  int32_t min_spp = 0;
 };
 
 struct BenchSpec {
