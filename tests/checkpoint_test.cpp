@@ -95,6 +95,22 @@ class CheckpointTest : public testing::Test {
     return j;
   }
 
+  // Runs `j` with a SIGTERM pending (blocked) on this thread when the render starts:
+  // the job's catcher takes it, so the render stops after its first pass (or step)
+  // with a last checkpoint. The signal is sent to this thread alone: one sent to the
+  // process would go to any other thread that does not block it (the CUDA driver's),
+  // and end the process before the catcher is there.
+  static JobOutcome run_with_sigterm_pending(const Job& j) {
+    sigset_t term, previous;
+    sigemptyset(&term);
+    sigaddset(&term, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &term, &previous);
+    ::pthread_kill(::pthread_self(), SIGTERM);
+    const JobOutcome out = run_job(j);
+    pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+    return out;
+  }
+
   test::TestFolder folder_;
   const fs::path dir_ = folder_.root();
   std::string scene_;
@@ -171,20 +187,10 @@ TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {
   const JobOutcome whole = run_job(job(path("whole.pfm")));
   ASSERT_EQ(whole.exit_code, 0) << whole.message;
 
-  // A SIGTERM is pending (blocked) on this thread when the render starts: the job's
-  // catcher takes it, so the render stops after its first pass with a last
-  // checkpoint. The signal is sent to this thread alone: one sent to the process
-  // would go to any other thread that does not block it (the CUDA driver's), and
-  // end the process before the catcher is there.
+  // A SIGTERM pending when the render starts stops it after its first pass.
   Job first = job(path("resumed.pfm"));
   first.checkpoint = path("r.ckpt");
-  sigset_t term, previous;
-  sigemptyset(&term);
-  sigaddset(&term, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &term, &previous);
-  ::pthread_kill(::pthread_self(), SIGTERM);
-  const JobOutcome stopped = run_job(first);
-  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  const JobOutcome stopped = run_with_sigterm_pending(first);
   EXPECT_EQ(stopped.exit_code, 128 + SIGTERM);
   EXPECT_EQ(stopped.message, "interrupted by SIGTERM at sample 16 of 64; checkpoint written to " + path("r.ckpt") +
                                  " (resume with --resume " + path("r.ckpt") + ")");
@@ -225,13 +231,7 @@ TEST_F(CheckpointTest, AnAdaptiveRenderStoppedBySigtermResumesToTheUninterrupted
 
   Job first = adaptive(path("resumed.pfm"));
   first.checkpoint = path("a.ckpt");
-  sigset_t term, previous;
-  sigemptyset(&term);
-  sigaddset(&term, SIGTERM);
-  pthread_sigmask(SIG_BLOCK, &term, &previous);
-  ::pthread_kill(::pthread_self(), SIGTERM);
-  const JobOutcome stopped = run_job(first);
-  pthread_sigmask(SIG_SETMASK, &previous, nullptr);
+  const JobOutcome stopped = run_with_sigterm_pending(first);
   EXPECT_EQ(stopped.exit_code, 128 + SIGTERM);
   EXPECT_EQ(stopped.message, "interrupted by SIGTERM at sample 8 of 256; checkpoint written to " + path("a.ckpt") +
                                  " (resume with --resume " + path("a.ckpt") + ")");

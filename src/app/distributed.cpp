@@ -194,12 +194,8 @@ RenderResult render_adaptive_ranks(const Cluster& cluster, const ChunkRenderer& 
   // This rank's run of a round's pixels rendered, the runs' sums added on rank 0.
   auto part = [&](int32_t first, int32_t count, const std::vector<uint32_t>* listed) {
     const size_t n = listed ? listed->size() : pixels;
-    const SamplePass cut = weighted_ranges(0, static_cast<int32_t>(n), weights)[static_cast<size_t>(cluster.rank())];
-    std::vector<uint32_t> run(static_cast<size_t>(cut.count));
-    for (size_t i = 0; i < run.size(); ++i) {
-      const size_t at = static_cast<size_t>(cut.first) + i;
-      run[i] = listed ? (*listed)[at] : static_cast<uint32_t>(at);
-    }
+    const std::vector<uint32_t> run =
+        pixel_run(listed, weighted_ranges(0, static_cast<int32_t>(n), weights)[static_cast<size_t>(cluster.rank())]);
     RenderResult r;
     if (!failed && !run.empty()) {
       try {

@@ -416,7 +416,7 @@ void render_alone(const Job& job, const Scene& scene, RenderOptions& options, Jo
         if (!state.stopping) draw(done, rays, seconds);
       };
       if (options.noise_threshold > 0) {
-        state.adaptive.converged = [&progress, pixels](uint64_t converged) { progress.converged(converged, pixels); };
+        state.adaptive.converged = progress.converged_callback(pixels);
       }
     }
     out.result = render(scene, options, state.adaptive);
@@ -445,7 +445,7 @@ void render_rank(const Job& job, const Scene& scene, RenderOptions& options, con
     if (job.progress && cluster.root()) {
       options.progress = progress.callback();
       if (options.noise_threshold > 0) {
-        hooks.converged = [&progress, pixels](uint64_t converged) { progress.converged(converged, pixels); };
+        hooks.converged = progress.converged_callback(pixels);
       }
     }
     out.result = render_adaptive_ranks(cluster, adaptive_rounds(scene, options), options, weights, hooks);

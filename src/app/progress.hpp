@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 
 #include "dispatch/renderer.hpp"
 
@@ -16,6 +17,10 @@ class ProgressLine {
   ProgressFn callback();
   // An adaptive render's pixels converged so far, of `pixels`: on the line from now on.
   void converged(uint64_t converged, uint64_t pixels);
+  // That, as the callback an adaptive render calls with its count (AdaptiveHooks).
+  std::function<void(uint64_t)> converged_callback(uint64_t pixels) {
+    return [this, pixels](uint64_t c) { converged(c, pixels); };
+  }
 
  private:
   void update(double done, uint64_t rays, double seconds);

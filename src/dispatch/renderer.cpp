@@ -33,14 +33,19 @@ std::vector<std::string> device_labels(const RenderOptions& options) {
   return labels;
 }
 
+// The backend's renderer of device `i` of the options' devices.
+DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options, size_t i) {
+  return options.backend == Backend::Cuda ? cuda::device_renderer(scene, options, i)
+                                          : cpu::device_renderer(scene, options, i);
+}
+
 RenderResult render_on_backend(const Scene& scene, const RenderOptions& options) {
   check_kernel_runs(options);
   const bool gpu = options.backend == Backend::Cuda;
   if (gpu) cuda::check_devices(options);
   if (options.devices.size() <= 1) return gpu ? cuda::render(scene, options) : cpu::render(scene, options);
-  return render_split(options, device_labels(options), [&](size_t i) {
-    return gpu ? cuda::device_renderer(scene, options, i) : cpu::device_renderer(scene, options, i);
-  });
+  return render_split(options, device_labels(options),
+                      [&](size_t i) { return device_renderer(scene, options, i); });
 }
 
 }  // namespace
@@ -66,18 +71,15 @@ ChunkRenderer adaptive_rounds(const Scene& scene, const RenderOptions& options) 
     throw std::logic_error("an adaptive render keeps its checkpoints and ranks through AdaptiveHooks");
   }
   check_kernel_runs(options);
-  const bool gpu = options.backend == Backend::Cuda;
-  if (gpu) cuda::check_devices(options);
+  if (options.backend == Backend::Cuda) cuda::check_devices(options);
   if (options.devices.size() <= 1) {
     RenderOptions one = options;
     one.devices = {options.devices.empty() ? 0 : options.devices.front()};
-    auto device = std::make_shared<DeviceRenderer>(gpu ? cuda::device_renderer(scene, one, 0)
-                                                       : cpu::device_renderer(scene, one, 0));
+    auto device = std::make_shared<DeviceRenderer>(device_renderer(scene, one, 0));
     return [device](const RenderOptions& round) { return device->render(round); };
   }
-  auto split = std::make_shared<PixelSplit>(options, device_labels(options), [&](size_t i) {
-    return gpu ? cuda::device_renderer(scene, options, i) : cpu::device_renderer(scene, options, i);
-  });
+  auto split = std::make_shared<PixelSplit>(options, device_labels(options),
+                                            [&](size_t i) { return device_renderer(scene, options, i); });
   return [split](const RenderOptions& round) { return split->render(round); };
 }
 

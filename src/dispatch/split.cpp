@@ -404,6 +404,15 @@ std::vector<SamplePass> weighted_ranges(int32_t first, int32_t count, const std:
   return out;
 }
 
+std::vector<uint32_t> pixel_run(const std::vector<uint32_t>* listed, const SamplePass& cut) {
+  std::vector<uint32_t> run(static_cast<size_t>(cut.count));
+  for (size_t i = 0; i < run.size(); ++i) {
+    const size_t at = static_cast<size_t>(cut.first) + i;
+    run[i] = listed ? (*listed)[at] : static_cast<uint32_t>(at);
+  }
+  return run;
+}
+
 // The devices' threads: each makes its renderer, then waits for a round (a new
 // `generation`), renders its run of pixels and reports back; the calling thread
 // hands the rounds out and waits for every device.
@@ -500,12 +509,7 @@ RenderResult PixelSplit::render(const RenderOptions& round) {
   const size_t listed = round.active_pixels ? round.active_pixels->size() : pixels;
   const std::vector<SamplePass> cut = weighted_ranges(0, static_cast<int32_t>(listed), w.speeds);
   for (size_t d = 0; d < cut.size(); ++d) {
-    std::vector<uint32_t>& run = w.runs[d];
-    run.resize(static_cast<size_t>(cut[d].count));
-    for (size_t i = 0; i < run.size(); ++i) {
-      const size_t at = static_cast<size_t>(cut[d].first) + i;
-      run[i] = round.active_pixels ? (*round.active_pixels)[at] : static_cast<uint32_t>(at);
-    }
+    w.runs[d] = pixel_run(round.active_pixels, cut[d]);
     w.results[d] = RenderResult();
   }
   const auto start = Clock::now();

@@ -46,6 +46,10 @@ RenderResult render_split(const RenderOptions& options, const std::vector<std::s
 // in proportion to its weight (rounded so that the ranges tile it exactly).
 std::vector<SamplePass> weighted_ranges(int32_t first, int32_t count, const std::vector<double>& weights);
 
+// The pixels of `cut`, a range of positions in `listed` (adaptive sampling's pixels
+// still going), or of every pixel where none are listed (positions are pixels then).
+std::vector<uint32_t> pixel_run(const std::vector<uint32_t>* listed, const SamplePass& cut);
+
 // The devices of one adaptive render (render/adaptive.hpp), kept ready across its
 // rounds: each on a thread of its own, with the renderer `make` made there (its
 // scene uploaded once). Each round cuts the pixels it names (options.active_pixels,
