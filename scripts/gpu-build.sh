@@ -10,9 +10,11 @@ export WAVETRACE_CUDA_ARCH=${WAVETRACE_CUDA_ARCH:-90}
 bash "$root/scripts/build.sh"
 mkdir -p "$root/.gpu/bin"
 cp "$WAVETRACE_BUILD/wavetrace" "$WAVETRACE_BUILD"/*_tests "$WAVETRACE_BUILD/wavetrace-gltf-tiles" "$root/.gpu/bin/"
-# The shared libraries they load (OpenEXR's family, the C++ runtime it needs) beside
-# them in lib/, where their RPATH looks first; glibc itself is the GPU machine's, and
-# so is Open MPI (its mpirun and libmpi.so.40 must be one installation).
+# The shared libraries they load beside them in lib/, where their RPATH looks first:
+# every one ldd finds (OpenEXR's family; Assimp's libassimp.so.5 with libdraco.so.7,
+# libminizip.so.1 and libz.so.1; the C++ runtime they need), so a new dependency
+# comes along by itself. glibc itself is the GPU machine's, and so is Open MPI (its
+# mpirun and libmpi.so.40 must be one installation).
 rm -rf "$root/.gpu/bin/lib" && mkdir -p "$root/.gpu/bin/lib"
 for b in "$root/.gpu/bin/wavetrace" "$root/.gpu/bin"/*_tests; do ldd "$b"; done |
   awk '$2 == "=>" && $3 ~ /^\// {print $3}' | sort -u |

@@ -3,7 +3,8 @@
 # packages already present are left alone and nothing is fetched.
 set -euo pipefail
 packages=(cmake ninja-build g++ libglm-dev nlohmann-json3-dev libstb-dev libcli11-dev libgtest-dev zlib1g-dev
-  libtinyobjloader-dev libtinygltf-dev libopenexr-dev libpugixml-dev python3 libopenmpi-dev openmpi-bin)
+  libtinyobjloader-dev libtinygltf-dev libopenexr-dev libpugixml-dev libassimp-dev python3 libopenmpi-dev
+  openmpi-bin)
 if [[ "${WAVETRACE_WITH_PLOTS:-0}" == 1 ]]; then
   packages+=(python3-matplotlib)
 fi

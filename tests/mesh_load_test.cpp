@@ -221,7 +221,7 @@ TEST_F(MeshLoad, ObjDropsAndCountsDegenerateTriangles) {
 
 TEST_F(MeshLoad, ObjErrorsNameTheFileAndTheProblem) {
   expect_error((folder_.root() / "missing.obj").string(), "cannot open mesh file (No such file or directory)");
-  expect_error(write("mesh.ply", "ply\n"), "unknown mesh format '.ply' (expected .obj, .gltf, .glb)");
+  expect_error(write("mesh.stl", "solid\n"), "unknown mesh format '.stl' (expected .obj, .gltf, .glb, .ply, .serialized)");
   expect_error(write("zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"), "malformed OBJ: line 4: ");
   expect_error(write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of");
   expect_error(write("empty.obj", "# nothing\nv 0 0 0\n"), "has no triangles");

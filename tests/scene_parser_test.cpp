@@ -422,7 +422,7 @@ TEST(SceneParser, UnknownTypesAreRejected) {
                 ": /materials/2/type: unknown material type 'plastik' (expected lambertian, metal, dielectric, "
                 "coated, emissive, conductor, glass, plastic, principled)");
   expect_error(with(doc, "/textures/1/type", "wood"), "/textures/1/type",
-               "unknown texture type 'wood' (expected checker, noise, image)");
+               "unknown texture type 'wood' (expected checker, noise, image, uv_checker)");
   expect_error(with(doc, "/sky/type", "hdri"), "/sky/type", "unknown sky type 'hdri' (expected gradient, uniform, environment)");
 }
 

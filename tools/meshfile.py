@@ -1,6 +1,7 @@
 """What the mesh-writing scene generators in tools/ share: a pure-Python GLB
-writer and checker, a tiny OBJ writer, deterministic noise and procedural
-shapes (icosphere, rock, tree).
+writer and checker, a tiny OBJ writer, PLY and Mitsuba serialized writers
+(and readers that check them), deterministic noise and procedural shapes
+(icosphere, rock, tree).
 
 The generators (make_terrain.py, make_instances.py, make_model_scenes.py)
 import this module as a sibling, as they do scenefile.py. Plain python3 only:
@@ -8,14 +9,17 @@ no numpy. Bulk data is built in array('f') / array('I') and written with
 tobytes(), never one struct.pack per number, so a million triangles take
 seconds.
 
-Run directly, it checks GLB files:
+Run directly, it checks GLB, PLY and serialized files, or checks its own
+PLY and serialized writers against its readers:
 
     python3 tools/meshfile.py check scenes/generated/*.glb
+    python3 tools/meshfile.py self-test
 
 Conventions of every mesh written here: counter-clockwise winding seen from
 the side the surface faces (the geometric normal (b - a) x (c - a) points
 out of a closed shape, and up out of a ground), shading normals of unit
-length at every vertex, glTF UVs with v = 0 at the image's top row.
+length at every vertex, glTF UVs with v = 0 at the image's top row (PLY and
+serialized UVs too: Mitsuba 3 reads both unflipped, v = 0 the top row).
 """
 
 import array
@@ -24,6 +28,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -470,15 +475,332 @@ def obj_stats(path):
     return lo, hi, vertices, triangles
 
 
+# ---------------------------------------------------------------- PLY and Mitsuba's serialized
+
+SERIALIZED_FORMAT = 0x041C
+SER_NORMALS, SER_UVS, SER_COLOURS, SER_FACE_NORMALS = 0x0001, 0x0002, 0x0008, 0x0010
+SER_SINGLE, SER_DOUBLE = 0x1000, 0x2000
+
+
+def _flat(values, width, typecode, what):
+    """VALUES (a flat array / list of numbers, or a sequence of WIDTH-tuples) as
+    one flat array of TYPECODE; raises ValueError if its length is not a
+    multiple of WIDTH."""
+    if isinstance(values, array.array):
+        out = values if values.typecode == typecode else array.array(typecode, values)
+    else:
+        values = list(values)
+        if values and isinstance(values[0], (tuple, list)):
+            if any(len(v) != width for v in values):
+                raise ValueError("%s: every item must have %d numbers" % (what, width))
+            out = array.array(typecode, (x for v in values for x in v))
+        else:
+            out = array.array(typecode, values)
+    if len(out) % width:
+        raise ValueError("%s: %d numbers, not a multiple of %d" % (what, len(out), width))
+    return out
+
+
+def _mesh_arrays(what, positions, triangles, normals, uvs, typecode="f"):
+    """The flat arrays of a mesh to write, checked: normals and UVs one per
+    position where given, every index within the positions."""
+    p = _flat(positions, 3, typecode, what + ": positions")
+    t = _flat(triangles, 3, "I", what + ": triangles")
+    n = len(p) // 3
+    if t and max(t) >= n:
+        raise ValueError("%s: index %d out of range (%d vertices)" % (what, max(t), n))
+    nn = None if normals is None else _flat(normals, 3, typecode, what + ": normals")
+    uu = None if uvs is None else _flat(uvs, 2, typecode, what + ": uvs")
+    if nn is not None and len(nn) != 3 * n:
+        raise ValueError("%s: %d normals for %d positions" % (what, len(nn) // 3, n))
+    if uu is not None and len(uu) != 2 * n:
+        raise ValueError("%s: %d UVs for %d positions" % (what, len(uu) // 2, n))
+    return p, t, nn, uu
+
+
+def write_ply(path, positions, triangles, normals=None, uvs=None, binary=True):
+    """A PLY mesh: POSITIONS, TRIANGLES (index triples, 0-based), NORMALS and
+    UVS (or None), each a sequence of tuples or a flat array. Binary little
+    endian, or ASCII with float32's shortest round-tripping text (%.9g). The
+    properties are x y z, nx ny nz, u v (float) and vertex_indices (uchar
+    count, uint indices). UVs are written as given: v = 0 the image's top row,
+    as Mitsuba 3 reads a PLY's v (no flip) and as glTF has it."""
+    p, t, n, u = _mesh_arrays(path, positions, triangles, normals, uvs)
+    nv, nt = len(p) // 3, len(t) // 3
+    props = ["x", "y", "z"] + (["nx", "ny", "nz"] if n is not None else []) + (["u", "v"] if u is not None else [])
+    header = ["ply", "format %s 1.0" % ("binary_little_endian" if binary else "ascii"),
+              "comment wavetrace tools/meshfile.py", "element vertex %d" % nv]
+    header += ["property float " + name for name in props]
+    header += ["element face %d" % nt, "property list uchar uint vertex_indices", "end_header"]
+    k = len(props)
+    # The vertex records interleaved: property j of vertex i at k * i + j.
+    record = array.array("f", bytes(4 * k * nv))
+    record[0::k], record[1::k], record[2::k] = p[0::3], p[1::3], p[2::3]
+    if n is not None:
+        record[3::k], record[4::k], record[5::k] = n[0::3], n[1::3], n[2::3]
+    if u is not None:
+        record[k - 2::k], record[k - 1::k] = u[0::2], u[1::2]
+    with open(path, "wb") as f:
+        f.write(("\n".join(header) + "\n").encode("ascii"))
+        if binary:
+            f.write(_le_bytes(record))
+            # Each face: the count 3 (one byte), then its three indices (12 bytes).
+            faces = bytearray(13 * nt)
+            faces[0::13] = b"\x03" * nt
+            index_bytes = _le_bytes(t)
+            for b in range(12):
+                faces[1 + b::13] = index_bytes[b::12]
+            f.write(bytes(faces))
+        else:
+            fmt = " ".join(["%.9g"] * k) + "\n"
+            f.write("".join(fmt % tuple(record[k * i:k * i + k]) for i in range(nv)).encode("ascii"))
+            f.write("".join("3 %d %d %d\n" % tuple(t[3 * i:3 * i + 3]) for i in range(nt)).encode("ascii"))
+
+
+def write_serialized(path, shapes):
+    """A Mitsuba serialized mesh file (version 4): SHAPES a list of dicts
+    {name, positions, triangles, normals, uvs, double}, normals and uvs None
+    where absent (as write_ply takes them), double True for float64 numbers.
+    Each shape is its header (0x041C, 4) and one zlib stream; the file ends
+    with the table of the shapes' offsets (u64) and their count (u32). UVs are
+    written as given (Mitsuba reads them unflipped: v = 0 the top row)."""
+    out, offsets = [], []
+    size = 0
+    for i, s in enumerate(shapes):
+        what = "%s: shape %d" % (path, i)
+        code = "d" if s.get("double") else "f"
+        p, t, n, u = _mesh_arrays(what, s["positions"], s["triangles"], s.get("normals"), s.get("uvs"), code)
+        name = s.get("name", "").encode("utf-8")
+        if b"\0" in name:
+            raise ValueError("%s: a name may not hold NUL" % what)
+        flags = (SER_DOUBLE if code == "d" else SER_SINGLE) | (SER_NORMALS if n is not None else 0) | \
+            (SER_UVS if u is not None else 0)
+        parts = [struct.pack("<I", flags), name + b"\0", struct.pack("<QQ", len(p) // 3, len(t) // 3), _le_bytes(p)]
+        parts += [_le_bytes(a) for a in (n, u) if a is not None] + [_le_bytes(t)]
+        blob = struct.pack("<HH", SERIALIZED_FORMAT, 4) + zlib.compress(b"".join(parts))
+        offsets.append(size)
+        out.append(blob)
+        size += len(blob)
+    with open(path, "wb") as f:
+        for blob in out:
+            f.write(blob)
+        f.write(struct.pack("<%dQI" % len(offsets), *(offsets + [len(offsets)])))
+
+
+def _from_le(typecode, data):
+    out = array.array(typecode)
+    out.frombytes(data)
+    if sys.byteorder != "little":
+        out.byteswap()
+    return out
+
+
+def read_ply(path):
+    """Re-reads a PLY as write_ply writes it (float vertex properties, a face
+    list of uchar count and int/uint indices; ASCII or binary little endian).
+    Returns {positions, normals, uvs, triangles} as flat arrays (None where
+    absent); raises ValueError naming what is wrong, as check_glb does."""
+    with open(path, "rb") as f:
+        data = f.read()
+
+    def bad(msg):
+        raise ValueError("%s: %s" % (path, msg))
+
+    end = data.find(b"end_header\n")
+    if not data.startswith(b"ply\n") or end < 0:
+        bad("not a PLY written by write_ply (no 'ply' line or no end_header)")
+    lines = data[:end].decode("ascii").splitlines()
+    body = data[end + len(b"end_header\n"):]
+    fmt, elements = None, []
+    for line in lines[1:]:
+        w = line.split()
+        if w[0] == "format":
+            fmt = w[1]
+        elif w[0] == "element":
+            elements.append((w[1], int(w[2]), []))
+        elif w[0] == "property":
+            elements[-1][2].append(w[1:])
+    if fmt not in ("ascii", "binary_little_endian") or [e[0] for e in elements] != ["vertex", "face"]:
+        bad("format %s, elements %r: not what write_ply writes" % (fmt, [e[0] for e in elements]))
+    (_, nv, vprops), (_, nt, fprops) = elements
+    names = [p[1] for p in vprops]
+    if any(p[0] != "float" for p in vprops) or fprops != [["list", "uchar", "uint", "vertex_indices"]] and \
+            fprops != [["list", "uchar", "int", "vertex_indices"]]:
+        bad("properties not as write_ply writes them")
+    k = len(names)
+    if fmt == "ascii":
+        words = body.split()
+        if len(words) != k * nv + 4 * nt:
+            bad("%d numbers after the header, expected %d" % (len(words), k * nv + 4 * nt))
+        record = array.array("f", (float(x) for x in words[:k * nv]))
+        faces = [int(x) for x in words[k * nv:]]
+        if any(faces[4 * i] != 3 for i in range(nt)):
+            bad("a face that is not a triangle")
+        tri = array.array("I", (faces[4 * i + 1 + c] for i in range(nt) for c in range(3)))
+    else:
+        if len(body) != 4 * k * nv + 13 * nt:
+            bad("%d bytes after the header, expected %d" % (len(body), 4 * k * nv + 13 * nt))
+        record = _from_le("f", body[:4 * k * nv])
+        faces = body[4 * k * nv:]
+        if faces[0::13] != b"\x03" * nt:
+            bad("a face that is not a triangle")
+        index_bytes = bytearray(12 * nt)
+        for b in range(12):
+            index_bytes[b::12] = faces[1 + b::13]
+        tri = _from_le("I", bytes(index_bytes))
+
+    def columns(*cols):
+        if not all(c in names for c in cols):
+            return None
+        out = array.array("f", bytes(4 * len(cols) * nv))
+        for j, c in enumerate(cols):
+            out[j::len(cols)] = record[names.index(c)::k]
+        return out
+
+    mesh = {"positions": columns("x", "y", "z"), "normals": columns("nx", "ny", "nz"), "uvs": columns("u", "v"),
+            "triangles": tri}
+    if mesh["positions"] is None:
+        bad("no x, y, z")
+    if tri and max(tri) >= nv:
+        bad("an index out of range (%d vertices)" % nv)
+    return mesh
+
+
+def read_serialized(path):
+    """Re-reads a Mitsuba serialized file (versions 3 and 4) through its table:
+    a list of {name, positions, normals, uvs, triangles, double} (flat arrays,
+    None where absent); raises ValueError naming what is wrong: a count that
+    disagrees with the inflated size, an index out of range, a bad table."""
+    with open(path, "rb") as f:
+        data = f.read()
+
+    def bad(msg):
+        raise ValueError("%s: %s" % (path, msg))
+
+    if len(data) < 8:
+        bad("too short")
+    fmt, version = struct.unpack_from("<HH", data, 0)
+    if fmt != SERIALIZED_FORMAT or version not in (3, 4):
+        bad("format 0x%04X version %d: not a serialized mesh of version 3 or 4" % (fmt, version))
+    count, = struct.unpack_from("<I", data, len(data) - 4)
+    entry = 8 if version == 4 else 4
+    table = len(data) - 4 - entry * count
+    if table < 4:
+        bad("a table of %d shapes does not fit" % count)
+    offsets = struct.unpack_from("<%d%s" % (count, "Q" if version == 4 else "I"), data, table)
+    shapes = []
+    for i, start in enumerate(offsets):
+        stop = offsets[i + 1] if i + 1 < count else table
+        if not start + 4 <= stop <= table or struct.unpack_from("<HH", data, start) != (fmt, version):
+            bad("shape %d: offset %d is not a shape's header" % (i, start))
+        try:
+            raw = zlib.decompress(data[start + 4:stop])
+        except zlib.error as e:
+            bad("shape %d: %s" % (i, e))
+        flags, = struct.unpack_from("<I", raw, 0)
+        at, name = 4, ""
+        if version == 4:
+            nul = raw.index(b"\0", 4)
+            name, at = raw[4:nul].decode("utf-8"), nul + 1
+        nv, nt = struct.unpack_from("<QQ", raw, at)
+        at += 16
+        code = "d" if flags & SER_DOUBLE else "f"
+        size = 8 if code == "d" else 4
+        arrays = {}
+        for key, flag, width in (("positions", None, 3), ("normals", SER_NORMALS, 3), ("uvs", SER_UVS, 2),
+                                 ("colours", SER_COLOURS, 3)):
+            if flag is None or flags & flag:
+                arrays[key] = _from_le(code, raw[at:at + size * width * nv])
+                at += size * width * nv
+            else:
+                arrays[key] = None
+        if len(raw) != at + 12 * nt:
+            bad("shape %d: %d vertices and %d triangles need %d bytes, the stream holds %d"
+                % (i, nv, nt, at + 12 * nt, len(raw)))
+        tri = _from_le("I", raw[at:])
+        if tri and max(tri) >= nv:
+            bad("shape %d: an index out of range (%d vertices)" % (i, nv))
+        shapes.append({"name": name, "positions": arrays["positions"], "normals": arrays["normals"],
+                       "uvs": arrays["uvs"], "triangles": tri, "double": code == "d"})
+    return shapes
+
+
+def _check_unit_normals(path, normals):
+    for k in range(0, len(normals or ()), 3 * 97):  # a sample: unit length
+        if abs(normals[k] ** 2 + normals[k + 1] ** 2 + normals[k + 2] ** 2 - 1) > 1e-4:
+            raise ValueError("%s: normal %d not of unit length" % (path, k // 3))
+
+
+def check_mesh_file(path):
+    """Checks a .glb, .ply or .serialized file (check_glb, read_ply,
+    read_serialized; unit normals). Returns (triangles, vertices)."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".ply":
+        meshes = [read_ply(path)]
+    elif ext == ".serialized":
+        meshes = read_serialized(path)
+    else:
+        return check_glb(path)
+    for m in meshes:
+        _check_unit_normals(path, m["normals"])
+    return sum(len(m["triangles"]) // 3 for m in meshes), sum(len(m["positions"]) // 3 for m in meshes)
+
+
+def self_test():
+    """Writes PLY (binary and ASCII) and serialized files of known contents into a
+    temporary folder and reads them back: every number as written (as float32,
+    or float64 for a double shape)."""
+    import tempfile
+    positions = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0.1)]
+    triangles = [(0, 1, 2), (0, 2, 3)]
+    normals = [(0, 0, 1)] * 4
+    uvs = [(0, 0), (1, 0), (1, 0.75), (0, 0.75)]
+    f32 = lambda seq: array.array("f", (x for v in seq for x in v))  # noqa: E731
+    with tempfile.TemporaryDirectory() as folder:
+        for binary in (True, False):
+            path = os.path.join(folder, "quad%d.ply" % binary)
+            write_ply(path, positions, triangles, normals, uvs, binary=binary)
+            m = read_ply(path)
+            assert m["positions"] == f32(positions) and m["normals"] == f32(normals), m
+            assert m["uvs"] == f32(uvs) and list(m["triangles"]) == [0, 1, 2, 0, 2, 3], m
+            assert check_mesh_file(path) == (2, 4)
+            write_ply(path, f32(positions), array.array("I", [0, 1, 2]), binary=binary)
+            m = read_ply(path)
+            assert m["normals"] is None and m["uvs"] is None and len(m["triangles"]) == 3, m
+        path = os.path.join(folder, "two.serialized")
+        write_serialized(path, [
+            {"name": "quad", "positions": positions, "triangles": triangles, "normals": normals, "uvs": uvs,
+             "double": False},
+            {"name": "tri", "positions": positions[:3], "triangles": triangles[:1], "normals": None, "uvs": None,
+             "double": True}])
+        a, b = read_serialized(path)
+        assert a["name"] == "quad" and not a["double"] and a["positions"] == f32(positions), a
+        assert a["normals"] == f32(normals) and a["uvs"] == f32(uvs) and list(a["triangles"]) == [0, 1, 2, 0, 2, 3]
+        assert b["name"] == "tri" and b["double"] and list(b["positions"]) == [x for v in positions[:3] for x in v]
+        assert b["normals"] is None and b["uvs"] is None and list(b["triangles"]) == [0, 1, 2], b
+        assert check_mesh_file(path) == (3, 7)
+        for wrong in ([(0, 1, 4)], [(0, 1)]):
+            try:
+                write_ply(os.path.join(folder, "wrong.ply"), positions, wrong)
+                raise AssertionError("write_ply took triangles %r" % wrong)
+            except ValueError:
+                pass
+    print("meshfile self-test: ok")
+    return 0
+
+
 def _main(argv):
+    if argv == ["self-test"]:
+        sys.exit(self_test())
     if len(argv) < 2 or argv[0] != "check":
-        sys.exit("usage: python3 tools/meshfile.py check FILE.glb...")
+        sys.exit("usage: python3 tools/meshfile.py check FILE.glb|FILE.ply|FILE.serialized...\n"
+                 "       python3 tools/meshfile.py self-test")
     failed = False
     for path in argv[1:]:
         try:
-            t, v = check_glb(path)
+            t, v = check_mesh_file(path)
             print("%s: ok, %d triangles, %d vertices" % (path, t, v))
-        except (ValueError, KeyError, struct.error) as e:
+        except (ValueError, KeyError, IndexError, struct.error) as e:
             print("%s: FAILED: %s" % (path, e))
             failed = True
     sys.exit(1 if failed else 0)

@@ -1,5 +1,8 @@
 #include "scene/input_file.hpp"
 
+#include <cctype>
+#include <filesystem>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -98,6 +101,12 @@ std::string read_input_file(const std::string& path, const InputKind& kind) {
     bytes.append(buf, static_cast<size_t>(n));
   }
   return bytes;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
 }
 
 }  // namespace wt

@@ -52,4 +52,8 @@ std::string read_input_file(const std::string& path, const InputKind& kind);
 // FIFO (named pipe), not a regular file"); empty for a regular file.
 std::string not_a_regular_file(unsigned int mode);
 
+// A file's extension in lower case, with its dot (".obj"); "" for none. Formats are
+// told apart by it, whatever its case.
+std::string lower_extension(const std::string& path);
+
 }  // namespace wt

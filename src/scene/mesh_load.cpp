@@ -1,6 +1,8 @@
 // Mesh files to TriangleMesh. The libraries parse (and tinyobjloader triangulates);
 // this file checks what they return (indices, accessor bounds, non-finite values),
 // drops degenerate triangles and maps materials (docs/scene-format.md, "Meshes").
+// PLY and Mitsuba's serialized meshes are read in mesh_ply.cpp and
+// mesh_serialized.cpp, and built here (add_indexed_mesh).
 #include "scene/mesh_load.hpp"
 
 #include <sys/stat.h>
@@ -25,6 +27,7 @@
 #include "errors/errors.hpp"
 #include "scene/input_file.hpp"
 #include "scene/json_reader.hpp"
+#include "scene/mesh_formats.hpp"
 #include "scene/mesh_libraries.hpp"
 #include "scene/scene.hpp"
 
@@ -166,6 +169,16 @@ Material make_material(MaterialKind kind, vec3 albedo, float fuzz, float ior, ve
 
 bool textured(MaterialKind kind) {
   return kind == MaterialKind::Lambertian || kind == MaterialKind::Metal || kind == MaterialKind::Coated;
+}
+
+// The material of faces the file gives none (OBJ faces before any usemtl or with no
+// MTL at all; every PLY and serialized triangle): white Lambertian, so that a
+// texture paired with the mesh shows as it is.
+MeshMaterial white_default_material() {
+  MeshMaterial d;
+  d.name = "default";
+  d.material = make_material(MaterialKind::Lambertian, vec3(1.0f), 0.0f, 1.0f, vec3(0.0f));
+  return d;
 }
 
 // ---- Wavefront OBJ + MTL ----
@@ -588,14 +601,6 @@ void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) 
     mesh.materials.push_back(map_mtl(materials[i], i < mtl.keys().size() ? mtl.keys()[i] : MtlKeys{}, dir, mesh));
   }
   int64_t fallback = -1;
-  // Faces before any usemtl (or with no MTL at all): white Lambertian, so that a
-  // texture paired with the mesh shows as it is.
-  auto make_default = [] {
-    MeshMaterial d;
-    d.name = "default";
-    d.material = make_material(MaterialKind::Lambertian, vec3(1.0f), 0.0f, 1.0f, vec3(0.0f));
-    return d;
-  };
 
   const size_t nv = attrib.vertices.size() / 3, nn = attrib.normals.size() / 3, nt = attrib.texcoords.size() / 2;
   auto position = [&](int i) { return glm::make_vec3(&attrib.vertices[3 * static_cast<size_t>(i)]); };
@@ -630,7 +635,7 @@ void load_obj(const std::string& text, const fs::path& dir, TriangleMesh& mesh) 
         corner[k] = it->second;
       }
       int id = shape.mesh.material_ids[f];
-      uint32_t material = id >= 0 ? static_cast<uint32_t>(id) : default_material(mesh, fallback, make_default);
+      uint32_t material = id >= 0 ? static_cast<uint32_t>(id) : default_material(mesh, fallback, white_default_material);
       builder.add_triangle(corner[0], corner[1], corner[2], material);
     }
   }
@@ -932,8 +937,7 @@ struct GltfImages {
       fail(path, what + " has neither a uri nor a buffer view");
     } else {
       key = (dir / gltf_uri_decode(image.uri)).lexically_normal().string();
-      std::string ext = fs::path(key).extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+      const std::string ext = lower_extension(key);
       if (ext == ".ktx2" || ext == ".basis") fail(path, what + kKtx2);
     }
     keys.emplace(source, key);
@@ -1359,10 +1363,7 @@ class GltfReader {
       if (!(inner >= 0.0 && inner < outer && outer <= 0.5 * kPi + 1e-6)) {
         fail(path, what + ": spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi / 2");
       }
-      // The extension's smooth step between the cones' cosines.
-      const float cos_inner = static_cast<float>(std::cos(inner)), cos_outer = static_cast<float>(std::cos(outer));
-      l.spot_scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
-      l.spot_offset = -cos_outer * l.spot_scale;
+      set_spot_cones(l, inner, outer);
     }
     l.position = vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
     const glm::dvec3 d = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
@@ -1538,11 +1539,44 @@ void load_gltf(const std::string& bytes, bool binary, const fs::path& dir, Trian
 
 }  // namespace
 
-TriangleMesh load_mesh(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
-    fail(path, "unknown mesh format '" + ext + "' (expected .obj, .gltf, .glb)");
+void add_indexed_mesh(const IndexedMesh& in, TriangleMesh& mesh) {
+  constexpr uint32_t kUnused = std::numeric_limits<uint32_t>::max();
+  MeshBuilder builder(mesh);
+  std::vector<size_t> kept;
+  std::vector<uint32_t> index(in.positions.size(), kUnused);  // the file's vertex -> the mesh's
+  for (size_t t = 0; t < in.triangles.size(); ++t) {
+    const std::array<uint32_t, 3>& c = in.triangles[t];
+    if (!builder.keep(in.positions[c[0]], in.positions[c[1]], in.positions[c[2]])) continue;
+    kept.push_back(t);
+    for (uint32_t v : c) index[v] = 0;
+  }
+  const bool normals = !in.normals.empty(), uvs = !in.uvs.empty();
+  for (size_t v = 0; v < index.size(); ++v) {
+    if (index[v] == kUnused) continue;
+    // Checked here, so that the message names the vertex as the file numbers it.
+    if (normals && (!finite(in.normals[v]) || glm::length(in.normals[v]) == 0.0f)) {
+      fail(mesh.source, "vertex " + std::to_string(v) + " has a zero or non-finite normal");
+    }
+    if (uvs && !(std::isfinite(in.uvs[v].x) && std::isfinite(in.uvs[v].y))) {
+      fail(mesh.source, "vertex " + std::to_string(v) + " has a non-finite texture coordinate");
+    }
+    index[v] = builder.add_vertex(in.positions[v], normals ? &in.normals[v] : nullptr, uvs ? &in.uvs[v] : nullptr);
+  }
+  if (!kept.empty()) {
+    int64_t fallback = -1;
+    const uint32_t material = default_material(mesh, fallback, white_default_material);
+    for (size_t t : kept) {
+      const std::array<uint32_t, 3>& c = in.triangles[t];
+      builder.add_triangle(index[c[0]], index[c[1]], index[c[2]], material);
+    }
+  }
+  builder.finish();
+}
+
+TriangleMesh load_mesh(const std::string& path, uint32_t shape_index) {
+  const std::string ext = lower_extension(path);
+  if (ext != ".obj" && ext != ".gltf" && ext != ".glb" && ext != ".ply" && ext != ".serialized") {
+    fail(path, "unknown mesh format '" + ext + "' (expected .obj, .gltf, .glb, .ply, .serialized)");
   }
   const std::string bytes = read_input_file(path, input::kMesh);
   const fs::path dir = fs::path(path).parent_path();
@@ -1550,10 +1584,21 @@ TriangleMesh load_mesh(const std::string& path) {
   mesh.source = path;
   if (ext == ".obj") {
     load_obj(bytes, dir, mesh);
+  } else if (ext == ".ply") {
+    load_ply(bytes, mesh);
+  } else if (ext == ".serialized") {
+    load_serialized(bytes, shape_index, mesh);
   } else {
     load_gltf(bytes, ext == ".glb", dir, mesh);
   }
   return mesh;
+}
+
+void set_spot_cones(PunctualLight& l, double inner, double outer) {
+  // KHR_lights_punctual's smooth step between the cones' cosines.
+  const float cos_inner = static_cast<float>(std::cos(inner)), cos_outer = static_cast<float>(std::cos(outer));
+  l.spot_scale = 1.0f / std::max(0.001f, cos_inner - cos_outer);
+  l.spot_offset = -cos_outer * l.spot_scale;
 }
 
 }  // namespace wt

@@ -1,5 +1,6 @@
-// Triangle meshes from Wavefront OBJ (+ MTL, through tinyobjloader) and glTF 2.0
-// (.gltf, .glb, through tinygltf), read into host arrays with their materials mapped
+// Triangle meshes from Wavefront OBJ (+ MTL, through tinyobjloader), glTF 2.0
+// (.gltf, .glb, through tinygltf), Stanford PLY (.ply, through Assimp) and Mitsuba's
+// serialized meshes (.serialized), read into host arrays with their materials mapped
 // onto wavetrace's (docs/scene-format.md, "Meshes"). A scene file's `meshes` name the
 // files and its `instances` place them (scene_meshes.cpp).
 #pragma once
@@ -137,9 +138,17 @@ struct TriangleMesh {
   size_t dropped_nan = 0;         // triangles with a non-finite position
 };
 
-// Reads a mesh file, its format chosen by extension (.obj, .gltf, .glb; any case).
-// A glTF file's default scene (or its first; or, with none, every mesh) is read with
-// its node transforms applied. Throws InputError "<path>: <what is wrong>".
-TriangleMesh load_mesh(const std::string& path);
+// A spot light's falloff between its inner and outer cones (radians, 0 <= inner <
+// outer <= pi / 2), as KHR_lights_punctual gives it (PunctualLight's spot_scale and
+// spot_offset).
+void set_spot_cones(PunctualLight& l, double inner, double outer);
+
+// Reads a mesh file, its format chosen by extension (.obj, .gltf, .glb, .ply,
+// .serialized; any case). A glTF file's default scene (or its first; or, with none,
+// every mesh) is read with its node transforms applied. shape_index picks the shape
+// of a .serialized file (0 the first; one past the file's shapes is an error); the
+// other formats hold one mesh and ignore it (the caller accepts only 0 for them).
+// Throws InputError "<path>: <what is wrong>".
+TriangleMesh load_mesh(const std::string& path, uint32_t shape_index = 0);
 
 }  // namespace wt

@@ -24,10 +24,20 @@ namespace wt {
 void SceneReader::read_texture(const json& j, const JsonPath& path) {
   object(j, path);
   remember(texture_names_, name(j, path), scene_.textures.size(), "texture", path);
-  size_t type = type_of(j, path, "texture", {"checker", "noise", "image"});
+  size_t type = type_of(j, path, "texture", {"checker", "noise", "image", "uv_checker"});
   // Image textures' defaults: untransformed, u repeating and v clamped (the
   // spheres' mapping runs v pole to pole).
   Texture t = image_texture(-1, Wrap::Repeat, Wrap::Clamp);
+  // The UV transform of image textures (and of the UV checker, an image).
+  auto uv_transform = [&] {
+    if (j.contains("uv_offset")) t.uv_offset = pair(j["uv_offset"], path / "uv_offset");
+    if (j.contains("uv_scale")) t.uv_scale = pair(j["uv_scale"], path / "uv_scale");
+    if (j.contains("uv_rotation")) {
+      const float r = number(j["uv_rotation"], path / "uv_rotation");
+      t.uv_cos = std::cos(r);
+      t.uv_sin = std::sin(r);
+    }
+  };
   if (type == 0) {
     check_keys(j, path, {"name", "type", "size", "even", "odd"}, "checker");
     t.kind = TextureKind::Checker;
@@ -41,6 +51,24 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
     t.octaves = j.contains("octaves") ? static_cast<int32_t>(integer(j["octaves"], path / "octaves", 1, 16)) : 7;
     t.a = colour(required(j, path, "high"), path / "high");
     t.b = colour(required(j, path, "low"), path / "low");
+  } else if (type == 3) {
+    // Squares in UV space, two to the unit: `even` where u and v are both in the
+    // lower or both in the upper half of their unit (after the transform), `odd`
+    // elsewhere. Held as a 2 x 2 image of those colours, read nearest and repeated,
+    // so the squares are exact at every distance.
+    check_keys(j, path, {"name", "type", "even", "odd", "uv_offset", "uv_scale", "uv_rotation"}, "uv_checker");
+    const vec3 even = colour(required(j, path, "even"), path / "even");
+    const vec3 odd = colour(required(j, path, "odd"), path / "odd");
+    t.kind = TextureKind::Image;
+    t.wrap_u = t.wrap_v = Wrap::Repeat;
+    t.filter = t.magnify = Filter::Nearest;
+    uv_transform();
+    Image im;
+    im.path = source() + "#" + (path / "even").str();
+    im.width = im.height = 2;
+    for (const vec3& c : {even, odd, odd, even}) im.texels.insert(im.texels.end(), {c.x, c.y, c.z, 1.0f});
+    t.image = static_cast<int32_t>(scene_.images.size());
+    scene_.images.push_back(std::move(im));
   } else {
     check_keys(j, path,
                {"name", "type", "file", "colorspace", "uv_offset", "uv_scale", "uv_rotation", "wrap", "filter"},
@@ -50,13 +78,7 @@ void SceneReader::read_texture(const json& j, const JsonPath& path) {
       if (t.filter == Filter::Nearest) t.magnify = Filter::Nearest;
     }
     t.kind = TextureKind::Image;
-    if (j.contains("uv_offset")) t.uv_offset = pair(j["uv_offset"], path / "uv_offset");
-    if (j.contains("uv_scale")) t.uv_scale = pair(j["uv_scale"], path / "uv_scale");
-    if (j.contains("uv_rotation")) {
-      const float r = number(j["uv_rotation"], path / "uv_rotation");
-      t.uv_cos = std::cos(r);
-      t.uv_sin = std::sin(r);
-    }
+    uv_transform();
     if (j.contains("wrap")) {
       static const std::vector<std::string> kWraps = {"repeat", "clamp", "mirror"};
       const json& w = j["wrap"];
@@ -119,12 +141,6 @@ int32_t SceneReader::image_file(const std::string& resolved, bool srgb, const st
 }
 
 namespace {
-
-std::string lower_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
 
 // Reads an image file whole (a regular file within the image limit); false with the
 // reason alone (the caller names the file).
