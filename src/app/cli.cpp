@@ -1,5 +1,6 @@
 #include "app/cli.hpp"
 
+#include <cctype>
 #include <cstdio>
 
 #include "errors/errors.hpp"
@@ -21,6 +22,12 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
            s.flag, [&job, id = s.id](int64_t v) { set_setting(job, id, v); }, s.help)
         ->check(CLI::Range(s.lo, s.hi));
   }
+  cmd.add_option_function<std::vector<std::string>>(
+         "-D,--define", [&job](const std::vector<std::string>& defines) { add_defines(job, defines, "-D"); },
+         "a Mitsuba scene's parameter: -D name=value (repeatable; before its <default>)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->allow_extra_args(false);
   cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
       ->check(CLI::IsMember(backend_choices()));
   cmd.add_option("--kernel", job.kernel, "the kernel: " + listed(kernel_names()))
@@ -57,7 +64,7 @@ Job RenderCommand::parsed() const {
 
 CLI::App* add_render_command(CLI::App& app, RenderCommand& cmd) {
   CLI::App* render = app.add_subcommand("render", "render one scene");
-  render->add_option("scene", cmd.job.scene, "scene file (JSON)")->required();
+  render->add_option("scene", cmd.job.scene, "scene file: wavetrace's JSON, or a Mitsuba 3 scene (.xml)")->required();
   render->add_option("-o,--output", cmd.job.output,
                      "image file: .png (8-bit), .pfm (linear float) or .exr (linear half or float)")
       ->required();
@@ -83,6 +90,7 @@ std::vector<std::string> render_arguments(const Job& job) {
   for (const Setting& s : settings()) {
     if (const std::optional<int64_t> v = given_setting(job, s.id)) add(s.flag, std::to_string(*v));
   }
+  for (const auto& [name, value] : job.defines) add("--define", name + "=" + value);
   add("--backend", job.backend);
   add("--kernel", job.kernel);
   if (job.devices != "all") add("--devices", job.devices);

@@ -22,6 +22,7 @@
 #include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "image/denoise.hpp"
+#include "scene/scene_file.hpp"
 #include "render/adaptive.hpp"
 
 namespace wt::app {
@@ -292,12 +293,14 @@ void take_rank_share(const Job& job, const Cluster& cluster, RenderOptions& opti
 void load_job(const Job& job, const Cluster& cluster, JobOutcome& out, std::optional<Scene>& scene,
               RenderOptions& options) {
   if (cluster.root()) check_outputs(job, cluster.distributed());
-  scene.emplace(load_scene(job.scene));
+  scene.emplace(load_scene(job.scene, job.defines));
   out.load_times = scene->load_times;
   out.geometry = scene->summary();
   // What a mesh file holds that is not rendered, once (by the root rank), and in the
   // stats file.
+  out.scene_warnings = scene->warnings;
   if (cluster.root()) {
+    for (const std::string& w : out.scene_warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     for (const auto& m : out.geometry.meshes) {
       for (const std::string& w : m.warnings) std::fprintf(stderr, "warning: %s: %s\n", m.file.c_str(), w.c_str());
     }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -16,6 +17,9 @@ namespace wt::app {
 
 struct Job {
   std::string scene;
+  // A Mitsuba scene's parameters (-D name=value), which take precedence over its
+  // <default>s; empty for a JSON scene.
+  std::map<std::string, std::string> defines;
   std::string output;
   std::string stats;  // empty: no stats file
   // The render settings (src/render/settings.hpp); unset: the scene's.
@@ -70,6 +74,8 @@ struct JobOutcome {
   int32_t min_spp = 0;
   LoadTimes load_times;
   Scene::Summary geometry;
+  // What the scene file says is not rendered as its source meant (Scene::warnings).
+  std::vector<std::string> scene_warnings;
   int32_t resumed_from_sample = 0;  // samples a resumed checkpoint held
   std::string backend, kernel;
   RenderResult result;
@@ -107,6 +113,9 @@ JobOutcome run_job(const Job& job, const Cluster& cluster);
 
 // Sets a setting of the table (already checked against its range).
 void set_setting(Job& job, SettingId id, int64_t value);
+// Adds "name=value" parameters of a Mitsuba scene to job.defines (a later one of a
+// name wins); throws InputError "<where>: ..." for one that is not name=value.
+void add_defines(Job& job, const std::vector<std::string>& defines, const std::string& where);
 // A setting the job was given: its value, or none where the job keeps the default.
 std::optional<int64_t> given_setting(const Job& job, SettingId id);
 

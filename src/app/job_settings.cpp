@@ -2,6 +2,8 @@
 // description, which needs no renderer.
 #include "app/job.hpp"
 
+#include <cctype>
+
 namespace wt::app {
 
 namespace {
@@ -53,6 +55,17 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
     case SettingId::MegakernelBatch: return unless_default(job.megakernel_batch, defaults.megakernel_batch);
     case SettingId::MinSpp: return unless_default(job.min_spp, defaults.min_spp);
     default: return std::nullopt;
+  }
+}
+
+void add_defines(Job& job, const std::vector<std::string>& defines, const std::string& where) {
+  for (const std::string& d : defines) {
+    const size_t eq = d.find('=');
+    const std::string name = d.substr(0, eq);
+    bool plain = eq != std::string::npos && !name.empty();
+    for (char c : name) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
+    if (!plain) throw InputError(where + ": '" + d + "' is not name=value (a name of letters, digits and _)");
+    job.defines[name] = d.substr(eq + 1);
   }
 }
 

@@ -9,6 +9,7 @@
 #include "render/settings.hpp"
 #include "scene/input_file.hpp"
 #include "scene/json_reader.hpp"
+#include "scene/mitsuba_scene.hpp"
 
 namespace wt::app {
 
@@ -25,7 +26,7 @@ std::string relative_to(const fs::path& base, const std::string& p) {
 const std::vector<std::string>& job_keys() {
   static const std::vector<std::string> keys = [] {
     std::vector<std::string> k = {"scene",    "output",    "stats",    "checkpoint",      "resume",    "backend",
-                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy", "aov"};
+                                  "kernel",   "encoding",  "exr_float", "denoise", "denoise_quality", "keep_noisy", "aov", "defines"};
     for (const Setting& s : settings()) k.push_back(s.key);
     return k;
   }();
@@ -63,6 +64,18 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.denoise_quality = denoise_quality_choices()[r.choice(value, at, denoise_quality_choices())];
     } else if (key == "keep_noisy") {
       job.keep_noisy = r.boolean(value, at);
+    } else if (key == "defines") {
+      // A Mitsuba scene's parameters, {"name": "value"}: strings, or numbers as written.
+      r.object(value, at);
+      job.defines.clear();
+      for (auto d = value.begin(); d != value.end(); ++d) {
+        if (!d.value().is_string() && !d.value().is_number()) r.fail_at(at / d.key(), "must be a string or a number");
+        try {
+          add_defines(job, {d.key() + "=" + (d.value().is_string() ? d.value().get<std::string>() : d.value().dump())}, "");
+        } catch (const InputError&) {
+          r.fail_at(at / d.key(), "a parameter's name is letters, digits and _");
+        }
+      }
     } else if (key == "aov") {
       job.aov = r.string(value, at);
       try {
@@ -101,6 +114,7 @@ std::optional<size_t> job_of_pointer(const std::string& at) {
 }  // namespace
 
 BatchInput batch_input(const std::string& path) {
+  if (mitsuba::is_mitsuba_scene(path)) return BatchInput::Scene;  // by its extension, as render reads it
   // Either kind of file, so the larger limit of the two.
   const std::string text = read_input_file(path, InputKind{"jobs file or scene file", input::kScene.max_bytes});
   const json doc = json::parse(text, nullptr, false);

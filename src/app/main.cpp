@@ -12,6 +12,7 @@
 #include "app/bench.hpp"
 #include "app/cli.hpp"
 #include "app/cluster.hpp"
+#include "app/convert.hpp"
 #include "app/job.hpp"
 #include "app/job_files.hpp"
 #include "device/device.hpp"
@@ -218,6 +219,17 @@ int run(int argc, char** argv, const Cluster& cluster) {
   CLI::App* worker = app.add_subcommand("worker", "")->group("");
   wt::app::BenchOptions bench_options;
   CLI::App* bench = add_bench_command(app, bench_options);
+  Job convert_job;  // its scene and parameters
+  std::string convert_output;
+  CLI::App* convert = app.add_subcommand("convert", "write a Mitsuba 3 scene (.xml) as the wavetrace scene (.json) it is read as");
+  convert->add_option("scene", convert_job.scene, "the Mitsuba scene (.xml)")->required();
+  convert->add_option("-o,--output", convert_output, "the wavetrace scene to write (.json)")->required();
+  convert->add_option_function<std::vector<std::string>>(
+             "-D,--define", [&convert_job](const std::vector<std::string>& d) { wt::app::add_defines(convert_job, d, "-D"); },
+             "a scene parameter: -D name=value (repeatable)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->allow_extra_args(false);
   std::string kernels_backend;
   CLI::App* kernels = app.add_subcommand("kernels", "list the kernels, one a line, in the order the docs use");
   kernels->add_option("--backend", kernels_backend, "only those that run on this backend: cuda or cpu")
@@ -229,10 +241,13 @@ int run(int argc, char** argv, const Cluster& cluster) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
     return refuse(cluster, e.what());
+  } catch (const wt::InputError& e) {  // -D name=value
+    return refuse(cluster, e.what());
   }
   if (*worker) return wt::app::run_batch_worker();
   if (*render) return run_render(render_command.parsed(), cluster);
   if (*kernels) return run_kernels(kernels_backend);
+  if (*convert) return wt::app::run_convert(convert_job.scene, convert_output, convert_job.defines);
   if (*bench) return run_bench_command(bench_options, cluster);
   return run_batch_command(batch_command, cluster);  // the one command left (one is required)
 }

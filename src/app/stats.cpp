@@ -156,6 +156,8 @@ nlohmann::json stats_json(const Job& job, const JobOutcome& o) {
   }
   add_measurements(j, r, r.seconds, o.load_times);
   j["geometry"] = geometry_json(o.geometry);
+  // A Mitsuba scene's mapping: what it renders otherwise than Mitsuba would.
+  j["scene_warnings"] = o.scene_warnings;
   return j;
 }
 

@@ -78,6 +78,12 @@ struct Scene {
   std::vector<std::string> material_names;  // per material
   std::vector<SceneMesh> meshes;
   std::vector<Placement> placements;
+  // The scene file's own `lights` (punctual, in world space), beside those its mesh
+  // files place.
+  std::vector<PunctualLight> file_lights;
+  // What the scene file says is not rendered as its source meant (a Mitsuba scene's
+  // mapping: mitsuba_scene.hpp), one line each.
+  std::vector<std::string> warnings;
   // The arrays that the renderer reads (scene_view.hpp's list; the comments there
   // say what each holds). The scene file fills the materials, textures, spheres and
   // the meshes' triangle arrays, one contiguous range per mesh; build_bvh puts the

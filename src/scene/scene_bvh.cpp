@@ -258,6 +258,13 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
   // Each placed mesh's punctual lights, in world space.
   scene.punctual_lights.clear();
   const float radius = scene_radius(scene);
+  auto add_punctual = [&](const PunctualLight& l) {
+    const float p = l.power(radius);
+    if (!(p > 0.0f)) return;
+    scene.lights.push_back(LightRef{kPunctualLight, static_cast<int32_t>(scene.punctual_lights.size())});
+    scene.punctual_lights.push_back(l);
+    power.push_back(p);
+  };
   for (size_t i = 0; i < scene.instances.size(); ++i) {
     const Instance& in = scene.instances[i];
     if (in.kind == PrimitiveKind::Sphere) continue;
@@ -265,13 +272,10 @@ void build_lights(Scene& scene, const std::vector<int32_t>& instance_mesh) {
       l.position = in.world_from_object.point(l.position);
       const vec3 d = in.world_from_object.vector(l.direction);
       l.direction = glm::length(d) > 0.0f ? glm::normalize(d) : l.direction;
-      const float p = l.power(radius);
-      if (!(p > 0.0f)) continue;
-      scene.lights.push_back(LightRef{kPunctualLight, static_cast<int32_t>(scene.punctual_lights.size())});
-      scene.punctual_lights.push_back(l);
-      power.push_back(p);
+      add_punctual(l);
     }
   }
+  for (const PunctualLight& l : scene.file_lights) add_punctual(l);
   const float sky = sky_light_power(scene);
   if (sky > 0.0f) {
     scene.lights.push_back(LightRef{kSkyLight, 0});

@@ -9,13 +9,16 @@
 #include "errors/errors.hpp"
 #include "scene/image_mips.hpp"
 #include "scene/mesh_tangents.hpp"
+#include "scene/mitsuba_scene.hpp"
+#include "scene/scene_file.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace wt {
 
 void SceneReader::read(const json& root) {
   const JsonPath top;
-  check_keys(root, top, {"camera", "sky", "render", "textures", "materials", "spheres", "meshes", "instances"});
+  check_keys(root, top,
+             {"camera", "sky", "render", "textures", "materials", "spheres", "meshes", "instances", "lights", "warnings"});
   read_camera(required(root, top, "camera"), top / "camera");
   if (root.contains("sky")) read_sky(root["sky"], top / "sky");
   if (root.contains("render")) read_render(root["render"], top / "render");
@@ -40,6 +43,16 @@ void SceneReader::read(const json& root) {
     const JsonPath path = top / "instances";
     const json& instances = array(root["instances"], path);
     for (size_t i = 0; i < instances.size(); ++i) read_instance(instances[i], path / i);
+  }
+  if (root.contains("lights")) {
+    const JsonPath path = top / "lights";
+    const json& lights = array(root["lights"], path);
+    for (size_t i = 0; i < lights.size(); ++i) read_light(lights[i], path / i);
+  }
+  if (root.contains("warnings")) {
+    const JsonPath path = top / "warnings";
+    const json& warnings = array(root["warnings"], path);
+    for (size_t i = 0; i < warnings.size(); ++i) scene_.warnings.push_back(string(warnings[i], path / i));
   }
   if (scene_.placements.empty()) {
     fail_at(top / "spheres", "the scene has nothing to render: it needs at least one sphere or one instance");
@@ -173,11 +186,20 @@ Scene parse_scene(const std::string& json_text, const std::string& source) {
   return prepare(std::move(root), source, seconds_since(start));
 }
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines) {
   const auto start = Clock::now();
+  if (mitsuba::is_mitsuba_scene(path)) {
+    json root = mitsuba::read_mitsuba_scene(path, defines);
+    return prepare(std::move(root), path, seconds_since(start));
+  }
+  if (!defines.empty()) {
+    throw InputError(path + ": parameters (-D " + defines.begin()->first + "=...) apply to a Mitsuba scene (.xml) only");
+  }
   json root = read_json_file(path, input::kScene);
   return prepare(std::move(root), path, seconds_since(start));
 }
+
+Scene load_scene(const std::string& path) { return load_scene(path, {}); }
 
 // Compact drops the misses before the sort, so only the materials' keys count.
 int Scene::sort_key_bits() const {

@@ -2,17 +2,27 @@
 // a mesh by a transform, with an optional material).
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <future>
 #include <limits>
 
+#include "scene/input_file.hpp"
 #include "scene/mesh_load.hpp"
+#include "scene/mesh_shapes.hpp"
 #include "errors/errors.hpp"
 #include "scene/scene_reader.hpp"
 
 namespace wt {
 
 namespace {
+
+// The other side out: each triangle's winding reversed, its normals turned round.
+void flip_normals(TriangleMesh& m) {
+  for (auto& t : m.triangles) std::swap(t[1], t[2]);
+  for (vec3& n : m.normals) n = -n;
+}
 
 Affine affine_of(const glm::dmat4& m) {
   Affine a;
@@ -28,25 +38,56 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   // Every file is read on a thread of its own; the scene takes them in file order,
   // so the first bad one (in the scene file's order) is the one reported.
   struct Spec {
-    std::string name, file;
-    int32_t material;
+    std::string name, file, shape;
+    uint32_t shape_index = 0;
+    int32_t material = -1;
+    bool face_normals = false, flip_normals = false;
+    bool alpha = false;
+    AlphaTest alpha_test{};
   };
   std::vector<Spec> specs;
   for (size_t i = 0; i < list.size(); ++i) {
     const JsonPath at = path / i;
     const json& j = list[i];
     object(j, at);
-    check_keys(j, at, {"name", "file", "material"});
+    check_keys(j, at, {"name", "file", "shape", "shape_index", "material", "face_normals", "flip_normals", "alpha"});
     Spec s;
     s.name = name(j, at);
     remember(mesh_names_, s.name, i, "mesh", at);
-    s.file = (base_dir_ / string(required(j, at, "file"), at / "file")).lexically_normal().string();
+    if (j.contains("shape") == j.contains("file")) fail_at(at, "give either \"file\" or \"shape\"");
+    if (j.contains("shape")) {
+      s.shape = string(j["shape"], at / "shape");
+      if (!is_shape_name(s.shape)) {
+        std::vector<std::string> names;
+        for (const char* const* n = shape_names(); *n != nullptr; ++n) names.emplace_back(*n);
+        fail_at(at / "shape", "unknown shape '" + s.shape + "' (expected " + listed(names) + ")");
+      }
+    } else {
+      s.file = (base_dir_ / string(j["file"], at / "file")).lexically_normal().string();
+    }
+    if (j.contains("shape_index")) {
+      s.shape_index = static_cast<uint32_t>(integer(j["shape_index"], at / "shape_index", 0, 0xffffffffLL));
+      if (lower_extension(s.file) != ".serialized") fail_at(at / "shape_index", "selects a shape of a .serialized file only");
+    }
     s.material = j.contains("material") ? material_named(j["material"], at / "material") : -1;
+    if (j.contains("face_normals")) s.face_normals = boolean(j["face_normals"], at / "face_normals");
+    if (j.contains("flip_normals")) s.flip_normals = boolean(j["flip_normals"], at / "flip_normals");
+    if (j.contains("alpha")) {
+      if (s.material < 0) fail_at(at / "alpha", "needs the mesh's \"material\" (a file's own materials carry their own alpha)");
+      s.alpha = true;
+      s.alpha_test = read_alpha(j["alpha"], at / "alpha");
+    }
     specs.push_back(std::move(s));
   }
   const auto start = Clock::now();
   std::vector<std::future<TriangleMesh>> loading;
-  for (const Spec& s : specs) loading.push_back(std::async(std::launch::async, load_mesh, s.file));
+  for (const Spec& s : specs) {
+    if (!s.shape.empty()) {
+      loading.push_back(std::async(std::launch::deferred, shape_mesh, s.shape));
+    } else {
+      loading.push_back(std::async(std::launch::async, [file = s.file, index = s.shape_index] { return load_mesh(file, index); }));
+    }
+  }
   // A mesh file's error names the scene file and the field that names the mesh
   // file, then the mesh file and what is wrong in it.
   std::vector<TriangleMesh> meshes;
@@ -54,6 +95,11 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   for (size_t i = 0; i < loading.size(); ++i) {
     try {
       meshes.push_back(loading[i].get());
+      if (specs[i].face_normals) {
+        meshes.back().normals.clear();
+        meshes.back().tangents.clear();
+      }
+      if (specs[i].flip_normals) flip_normals(meshes.back());
     } catch (const InputError& e) {
       if (first_error.empty()) first_error = source() + ": " + (path / i / "file").str() + ": " + e.what();
     }
@@ -62,14 +108,52 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   mesh_seconds_ += seconds_since(start);
   for (size_t i = 0; i < meshes.size(); ++i) {
     try {
-      add_mesh(meshes[i], specs[i].name, specs[i].material);
+      add_mesh(meshes[i], specs[i].name, specs[i].material, specs[i].alpha ? &specs[i].alpha_test : nullptr);
     } catch (const InputError& e) {  // a texture its materials name, its size
       throw InputError(source() + ": " + (path / i / "file").str() + ": " + e.what());
     }
   }
 }
 
-void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override) {
+AlphaTest SceneReader::read_alpha(const json& j, const JsonPath& path) {
+  object(j, path);
+  check_keys(j, path, {"mode", "opacity", "texture", "channel", "cutoff"});
+  AlphaTest a{};
+  a.mode = choice(required(j, path, "mode"), path / "mode", {"blend", "mask"}) == 0 ? AlphaMode::Blend : AlphaMode::Mask;
+  a.factor = j.contains("opacity") ? unit_interval(j["opacity"], path / "opacity") : 1.0f;
+  a.cutoff = 0.5f;
+  if (j.contains("cutoff")) {
+    if (a.mode != AlphaMode::Mask) fail_at(path / "cutoff", "applies to \"mode\": \"mask\" only");
+    a.cutoff = unit_interval(j["cutoff"], path / "cutoff");
+  }
+  a.texture = -1;
+  if (j.contains("texture")) {
+    const JsonPath at = path / "texture";
+    a.texture = texture_named(j["texture"], at);
+    const Texture t = scene_.textures[static_cast<size_t>(a.texture)];
+    if (t.kind != TextureKind::Image) fail_at(at, "must be an image texture (its A channel, or its luminance, is the alpha)");
+    if (j.contains("channel") && choice(j["channel"], path / "channel", {"alpha", "luminance"}) == 1) {
+      // The image's luminance (Rec. 709 weights of its linear colour) as its alpha, in
+      // an image of its own.
+      Image im = scene_.images[static_cast<size_t>(t.image)];
+      for (size_t k = 0; k + 3 < im.texels.size(); k += 4) {
+        im.texels[k + 3] = 0.2126f * im.texels[k] + 0.7152f * im.texels[k + 1] + 0.0722f * im.texels[k + 2];
+      }
+      im.path += "#luminance";
+      scene_.images.push_back(std::move(im));
+      Texture lum = t;
+      lum.image = static_cast<int32_t>(scene_.images.size() - 1);
+      scene_.textures.push_back(lum);
+      a.texture = static_cast<int32_t>(scene_.textures.size() - 1);
+    }
+  } else if (j.contains("channel")) {
+    fail_at(path / "channel", "reads the alpha's \"texture\": give one");
+  }
+  return a;
+}
+
+void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override,
+                           const AlphaTest* alpha) {
   const size_t total = scene_.triangles.size() + mesh.triangles.size();
   if (total > static_cast<size_t>(std::numeric_limits<int32_t>::max()) ||
       scene_.normals.size() + mesh.positions.size() > std::numeric_limits<uint32_t>::max()) {
@@ -203,13 +287,20 @@ void SceneReader::add_mesh(const TriangleMesh& mesh, const std::string& name, in
     }
   }
   const uint32_t flags = (normals ? kTriangleHasNormals : 0u) | (uvs ? kTriangleHasUvs : 0u);
+  // The scene's alpha for the mesh under its scene material (an instance's material
+  // replaces it, as it replaces a file's).
+  uint32_t override_alpha = 0u;
+  if (alpha != nullptr && material_override >= 0) {
+    override_alpha = static_cast<uint32_t>(scene_.alpha_tests.size()) + 1u;
+    scene_.alpha_tests.push_back(*alpha);
+  }
   scene_.triangles.reserve(total);
   scene_.triangle_shadings.reserve(total);
   scene_.triangle_materials.reserve(total);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const auto& v = mesh.triangles[t];
     TriangleGeom g{};
-    g.alpha = material_override >= 0 ? 0u : alpha_of[mesh.triangle_material[t]];
+    g.alpha = material_override >= 0 ? override_alpha : alpha_of[mesh.triangle_material[t]];
     for (int c = 0; c < 3; ++c) {
       const vec3& p = mesh.positions[v[c]];
       float* dst = c == 0 ? g.p0 : (c == 1 ? g.p1 : g.p2);

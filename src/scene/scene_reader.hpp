@@ -83,12 +83,19 @@ class SceneReader : JsonReader {
   // A texture by name (the field's value); an error names the field.
   int32_t texture_named(const json& j, const JsonPath& path) const;
 
+  // scene_lights.cpp
+  void read_light(const json& j, const JsonPath& path);
+
   // scene_geometry.cpp
   void read_sphere(const json& j, const JsonPath& path);
 
   // scene_meshes.cpp
   void read_meshes(const json& list, const JsonPath& path);
-  void add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override);
+  // `alpha`: the mesh entry's own (with its material), or null.
+  void add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override,
+                const AlphaTest* alpha = nullptr);
+  // A mesh entry's `alpha`: the test, its luminance image made where it reads that.
+  AlphaTest read_alpha(const json& j, const JsonPath& path);
   void read_instance(const json& j, const JsonPath& path);
   // A material's index by its name in the scene file.
   int32_t material_named(const json& j, const JsonPath& path) const;

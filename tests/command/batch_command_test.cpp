@@ -3,6 +3,7 @@
 // each in a process of its own, on the CPU, and on CUDA where a device is present;
 // jobs that would write one file, inputs that are no jobs file, and (through
 // `wavetrace render`) a FIFO for a scene and a disk that fills up.
+#include <algorithm>
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
@@ -282,8 +283,50 @@ TEST_F(BatchCommand, AJobsFileWithDefaultsButNoJobsIsBadInput) {
 
 TEST_F(BatchCommand, AnUnknownCommandIsNamedWithTheCommands) {
   EXPECT_EQ(wavetrace("frobnicate"), 2);
-  EXPECT_EQ(err_, "wavetrace: unknown command 'frobnicate' (the commands: render, batch, bench, kernels)\n");
+  EXPECT_EQ(err_, "wavetrace: unknown command 'frobnicate' (the commands: render, batch, bench, convert, kernels)\n");
   EXPECT_EQ(out_, "");
+}
+
+// Mitsuba scenes through the command: a parameter from -D, a batch of XML and JSON
+// scenes, convert, and each kind of bad file one line, exit 2 and no image.
+TEST_F(BatchCommand, MitsubaScenesRenderWithParametersAndEachBadOneIsOneLine) {
+  const std::string head = R"(<scene version="3.0.0">
+  <default name="r" value="0.5"/>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="12"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="constant"/>
+)";
+  std::ofstream(path("m.xml")) << head << R"(<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectance" value="$r"/></bsdf></shape></scene>)";
+  EXPECT_EQ(wavetrace("render '" + path("m.xml") + "' -o '" + path("m.pfm") + "' -D r=0.25 --backend cpu --spp 2 -q"), 0) << err_;
+  EXPECT_TRUE(fs::exists(path("m.pfm")));
+  EXPECT_EQ(wavetrace("render '" + path("m.xml") + "' -o '" + path("n.pfm") + "' -D 'r 0.25' --backend cpu -q"), 2);
+  EXPECT_NE(err_.find("-D: 'r 0.25' is not name=value"), std::string::npos) << err_;
+  EXPECT_EQ(wavetrace("convert '" + path("m.xml") + "' -o '" + path("j.json") + "' -D r=0.25"), 0) << err_;
+  EXPECT_TRUE(fs::exists(path("j.json")));
+  EXPECT_EQ(batch("'" + path("m.xml") + "' '" + path("j.json") + "' --output-dir '" + path("") + "' --backend cpu --spp 2"), 0)
+      << err_;
+  EXPECT_TRUE(fs::exists(path("m.png")));
+  EXPECT_TRUE(fs::exists(path("j.png")));
+
+  const struct {
+    std::string body, message;
+  } bad[] = {
+      {"<shape type=\"sphere\"></scene", "malformed XML"},
+      {"<shape type=\"teapot\"/></scene>", "teapot: shape type 'teapot' is not supported"},
+      {"<shape type=\"obj\"><string name=\"filename\" value=\"none.obj\"/></shape></scene>", "obj: file 'none.obj' does not exist"},
+      {"<shape type=\"sphere\"><transform name=\"to_world\"><shear/></transform></shape></scene>", "unknown operation <shear>"},
+      {"<include filename=\"bad.xml\"/><shape type=\"sphere\"/></scene>", "includes itself"},
+  };
+  for (const auto& b : bad) {
+    std::ofstream(path("bad.xml")) << head << b.body;
+    EXPECT_EQ(wavetrace("render '" + path("bad.xml") + "' -o '" + path("bad.png") + "' --backend cpu -q"), 2) << b.body;
+    EXPECT_NE(err_.find(path("bad.xml") + ":"), std::string::npos) << err_;
+    EXPECT_NE(err_.find(b.message), std::string::npos) << err_;
+    EXPECT_EQ(std::count(err_.begin(), err_.end(), '\n'), 1) << err_;
+    EXPECT_FALSE(fs::exists(path("bad.png")));
+  }
 }
 
 // A disk that fills up, for real: files of the command may not grow past one block
