@@ -4,6 +4,8 @@ scene dicts, and rendered with Mitsuba's path tracer, timed as wavetrace's
 renders are (one warm-up render, then the median of 3).
 
     python3 bench/mitsuba_peer.py convert SCENE.json [--width W ...]   # the dict and the notes
+    python3 bench/mitsuba_peer.py xml SCENE.json -o SCENE.xml [...]    # the same as Mitsuba XML
+    python3 bench/mitsuba_peer.py render SCENE.xml [-D name=value] [--spp N] ...  # a Mitsuba scene as it is
     python3 bench/mitsuba_peer.py regions SCENE.json --width W --height H -o REGIONS.json
             # each placed glTF mesh's pixel boxes, for bench/peer_regions.py
     python3 bench/mitsuba_peer.py render SCENE.json --width W --height H --spp N --depth D
@@ -2417,8 +2419,132 @@ def load_scene(conversion, variant):
     import drjit as dr
     if mi.variant() != variant:
         mi.set_variant(variant)
+    if isinstance(conversion, XmlScene):
+        return mi.load_file(conversion.path, **conversion.defines)
     register_python_plugins(mi, dr, conversion.python_plugins)
     return mi.load_dict(realize(mi, conversion.scene))
+
+
+# --------------------------------------------------------------------------
+# The dict as a Mitsuba XML file (the `xml` command), which wavetrace reads back
+# --------------------------------------------------------------------------
+
+# The element each plugin type is written as.
+PLUGIN_TAGS = {
+    "integrator": ("path", "volpath", "direct"),
+    "sensor": ("perspective", "thinlens"),
+    "film": ("hdrfilm",),
+    "rfilter": ("box", "gaussian"),
+    "sampler": ("independent", "stratified", "multijitter"),
+    "shape": ("sphere", "obj", "ply", "serialized", "rectangle", "cube", "disk", "cylinder", "shapegroup", "instance"),
+    "emitter": ("area", "constant", "envmap", "point", "spot", "directional"),
+    "texture": ("bitmap", "checkerboard"),
+    "medium": ("homogeneous",),
+}
+
+
+class XmlError(Exception):
+    pass
+
+
+def _xml_number(x):
+    return repr(float(x)) if isinstance(x, float) else str(x)
+
+
+def _xml_attr(text):
+    return (str(text).replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;").replace(">", "&gt;"))
+
+
+def to_xml(scene, base_dir):
+    """The converter's dict (Mitsuba's load_dict form) as an XML <scene>, the files it
+    names relative to base_dir. Only what XML can say: no Python plugins, no values
+    made at load time (XmlError names what is not)."""
+    lines = ['<scene version="3.0.0">']
+
+    def tag_of(plugin, key):
+        if key == "bsdf" or key.startswith("bsdf"):
+            return "bsdf"
+        for tag, types in PLUGIN_TAGS.items():
+            if plugin in types:
+                return tag
+        if plugin in ("diffuse", "twosided", "conductor", "roughconductor", "dielectric", "roughdielectric",
+                      "thindielectric", "plastic", "roughplastic", "principled", "normalmap", "bumpmap", "mask"):
+            return "bsdf"
+        raise XmlError("plugin '%s' has no XML form wavetrace reads" % plugin)
+
+    def value(name, v, pad):
+        if isinstance(v, bool):
+            lines.append('%s<boolean name="%s" value="%s"/>' % (pad, name, "true" if v else "false"))
+        elif isinstance(v, int):
+            lines.append('%s<integer name="%s" value="%d"/>' % (pad, name, v))
+        elif isinstance(v, float):
+            lines.append('%s<float name="%s" value="%s"/>' % (pad, name, _xml_number(v)))
+        elif isinstance(v, str):
+            if name == "filename":
+                v = os.path.relpath(v, base_dir) if os.path.isabs(v) else v
+            lines.append('%s<string name="%s" value="%s"/>' % (pad, name, _xml_attr(v)))
+        elif isinstance(v, dict) and "__transform__" in v:
+            rows = v["__transform__"]
+            lines.append('%s<transform name="%s"><matrix value="%s"/></transform>'
+                         % (pad, name, " ".join(_xml_number(float(x)) for r in rows for x in r)))
+        elif isinstance(v, dict) and v.get("type") == "rgb":
+            c = v["value"]
+            lines.append('%s<rgb name="%s" value="%s"/>' % (pad, name, ", ".join(_xml_number(float(x)) for x in c)))
+        elif isinstance(v, dict) and v.get("type") == "ref":
+            lines.append('%s<ref id="%s" name="%s"/>' % (pad, _xml_attr(v["id"]), name))
+        elif isinstance(v, dict) and "type" in v:
+            plugin(name, v, pad)
+        else:
+            raise XmlError("'%s' (%s) has no XML form" % (name, json.dumps(v)[:80]))
+
+    def plugin(key, d, pad, ident=None):
+        t = d["type"]
+        tag = tag_of(t, key)
+        attrs = 'type="%s"' % t
+        if ident:
+            attrs += ' id="%s"' % _xml_attr(ident)
+        elif tag not in ("bsdf", "shape", "emitter", "film", "sampler", "rfilter", "integrator", "sensor") or \
+                (tag == "bsdf" and key != "bsdf"):
+            attrs += ' name="%s"' % _xml_attr(key)
+        lines.append("%s<%s %s>" % (pad, tag, attrs))
+        for k, v in d.items():
+            if k == "type" or k == "id":
+                continue
+            value(k, v, pad + "  ")
+        lines.append("%s</%s>" % (pad, tag))
+
+    for key, v in scene.items():
+        if key == "type":
+            continue
+        if not isinstance(v, dict) or "type" not in v:
+            raise XmlError("'%s' at the scene's top level is not a plugin" % key)
+        tag = tag_of(v["type"], key)
+        # Top-level BSDFs and textures are referenced by their key; the rest stand alone.
+        plugin(key, v, "  ", ident=key if tag in ("bsdf", "texture", "shape") else None)
+    lines.append("</scene>")
+    return "\n".join(lines) + "\n"
+
+
+def cmd_xml(args):
+    conv = convert(args.scene, **convert_kwargs(args))
+    if conv.python_plugins:
+        print("%s: needs Python plugins (%s), which XML cannot name" % (args.scene, ", ".join(conv.python_plugins)),
+              file=sys.stderr)
+        return 2
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    try:
+        text = to_xml(conv.scene, out_dir)
+    except XmlError as e:
+        print("%s: %s" % (args.scene, e), file=sys.stderr)
+        return 2
+    notes = "".join("  - %s\n" % n.replace("--", "- -") for n in conv.notes)
+    header = "<!-- %s as a Mitsuba 3 scene (bench/mitsuba_peer.py xml).%s -->\n" % (
+        os.path.basename(args.scene), ("\n  What does not map exactly:\n" + notes) if notes else "")
+    tmp = args.output + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(header + text)
+    os.replace(tmp, args.output)
+    return 0
 
 
 # --------------------------------------------------------------------------
@@ -2508,8 +2634,48 @@ def median(xs):
     return ys[n // 2] if n % 2 else 0.5 * (ys[n // 2 - 1] + ys[n // 2])
 
 
+class XmlScene:
+    """A Mitsuba scene file rendered as it is: its own sensor, film and integrator
+    (the spp may be given), read with the parameters `defines`."""
+
+    def __init__(self, path, defines, spp=None, seed=None):
+        import xml.etree.ElementTree as ET
+        self.path, self.defines = path, defines
+        self.notes, self.python_plugins = [], []
+        params = {}
+        root = ET.parse(path).getroot()
+        for d in root.iter("default"):
+            params[d.get("name")] = d.get("value")
+        params.update(defines)
+
+        def resolve(text):
+            return re.sub(r"\$([A-Za-z0-9_]+)", lambda m: params.get(m.group(1), m.group(0)), text or "")
+
+        def number(parent, kind, name, default):
+            for e in parent.iter(kind):
+                if e.get("name") == name:
+                    return int(float(resolve(e.get("value"))))
+            return default
+        film = next(root.iter("film"), None)
+        sampler = next(root.iter("sampler"), None)
+        integrator = next(root.iter("integrator"), None)
+        depth = -1
+        if integrator is not None:
+            depth = 2 if integrator.get("type") == "direct" else number(integrator, "integer", "max_depth", -1)
+        self.settings = {
+            "width": number(film, "integer", "width", 768) if film is not None else 768,
+            "height": number(film, "integer", "height", 576) if film is not None else 576,
+            "spp": spp or (number(sampler, "integer", "sample_count", 4) if sampler is not None else 4),
+            "depth": depth,
+            "roulette_depth": number(integrator, "integer", "rr_depth", 5) if integrator is not None else 5,
+            "seed": seed or 0, "nee": 1}
+
+
 def cmd_render(args):
-    conv = convert(args.scene, **convert_kwargs(args))
+    if args.scene.lower().endswith(".xml"):
+        conv = XmlScene(args.scene, dict(d.split("=", 1) for d in (args.define or [])), args.spp, args.seed)
+    else:
+        conv = convert(args.scene, **convert_kwargs(args))
     for n in conv.notes:
         print("note: " + n, file=sys.stderr)
     import mitsuba as mi
@@ -2595,9 +2761,14 @@ def main(argv=None):
     p.add_argument("--shrink", type=float, default=0.5,
                    help="the inner box's share of the tile's projected box, about its centre (default 0.5)")
     p.add_argument("-o", "--output", help="the regions file (default: stdout)")
-    for name in ("convert", "render"):
+    for name in ("convert", "render", "xml"):
         p = sub.add_parser(name)
         p.add_argument("scene")
+        if name == "xml":
+            p.add_argument("-o", "--output", required=True, help="the Mitsuba scene to write (.xml)")
+        if name == "render":
+            p.add_argument("-D", "--define", action="append",
+                           help="a parameter of an .xml scene, name=value (the file itself is rendered)")
         p.add_argument("--width", type=int)
         p.add_argument("--height", type=int)
         p.add_argument("--spp", type=int)
@@ -2629,6 +2800,8 @@ def main(argv=None):
     try:
         if args.command == "regions":
             return cmd_regions(args)
+        if args.command == "xml":
+            return cmd_xml(args)
         return cmd_convert(args) if args.command == "convert" else cmd_render(args)
     except ConversionError as e:
         print("%s: %s" % (args.scene, e), file=sys.stderr)

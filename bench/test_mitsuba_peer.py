@@ -1379,5 +1379,42 @@ class EmittedPluginsTest(Base):
         self.assertEqual(set(mp.EMITTED_PLUGINS) - kept - {"scene", "rgb"}, set())
 
 
+class XmlTest(Base):
+    """The dict written as Mitsuba XML (the `xml` command): every value in the
+    element Mitsuba reads it from; wavetrace reads the shipped results back
+    (tests/mitsuba_scene_test.cpp)."""
+
+    def test_dict_as_xml(self):
+        import xml.etree.ElementTree as ET
+        doc = scene_doc(materials=[{"name": "gold", "type": "conductor", "metal": "gold", "roughness": 0.5,
+                                    "masking": "separable", "energy_compensation": False}],
+                        spheres=[{"center": [1, 2, 3], "radius": 0.5, "material": "gold"}])
+        conv = self.convert(doc)
+        root = ET.fromstring(mp.to_xml(conv.scene, self.tmp))
+        self.assertEqual(root.tag, "scene")
+        self.assertEqual(root.get("version"), "3.0.0")
+        sensor = root.find("sensor")
+        self.assertEqual(sensor.get("type"), "perspective")
+        self.assertEqual(sensor.find("film").find("rfilter").get("type"), "box")
+        self.assertEqual(len(sensor.find("transform").find("matrix").get("value").split()), 16)
+        sphere = [e for e in root.findall("shape") if e.get("type") == "sphere"][0]
+        ref = sphere.find("ref")
+        bsdf = [e for e in root.findall("bsdf") if e.get("id") == ref.get("id")][0]
+        inner = bsdf.find("bsdf") if bsdf.get("type") == "twosided" else bsdf
+        self.assertEqual(inner.get("type"), "roughconductor")
+        alpha = [e for e in inner.findall("float") if e.get("name") == "alpha"][0]
+        self.assertAlmostEqual(float(alpha.get("value")), 0.25)
+        self.assertEqual(len(inner.find("rgb").get("value").split(",")), 3)
+
+    def test_python_plugins_refused(self):
+        doc = scene_doc(textures=[{"name": "c", "type": "checker", "size": 1, "even": [1, 1, 1], "odd": [0, 0, 0]}],
+                        materials=[{"name": "grey", "type": "lambertian", "texture": "c"}])
+        path = os.path.join(self.tmp, "c.json")
+        with open(path, "w") as f:
+            json.dump(doc, f)
+        self.assertEqual(mp.main(["xml", path, "-o", os.path.join(self.tmp, "c.xml")]), 2)
+        self.assertFalse(os.path.exists(os.path.join(self.tmp, "c.xml")))
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -33,10 +33,12 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # rendering every shipped scene (and the shapegroup path) with the LLVM variant.
 # "scene" is part of libmitsuba. The glTF tiles add principledthin, mask, the
 # punctual lights (point, spot, directional), and volpath with a homogeneous
-# medium of a constvolume for absorbing volumes; bump maps add bumpmap.
+# medium of a constvolume for absorbing volumes; bump maps add bumpmap; the shipped
+# Mitsuba scenes (scenes/mitsuba/) the built-in shapes, serialized and checkerboard.
 PLUGINS="area isotropic bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
 bumpmap normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
-srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume"
+srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume
+rectangle cube disk cylinder serialized checkerboard"
 
 py_local=$(command -v python3)
 export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1

@@ -219,10 +219,9 @@ class Converter {
     read_integrator(integrator);
     if (const Object* other = p.child("integrator", "", true)) fail(*other, "a second integrator");
     // Objects declared at the top with an id, used through <ref>: each is mapped
-    // where it is used (a bsdf or texture that nothing uses is read all the same).
+    // where a shape uses it (as an emitter's surface, not at all).
     for (const Object* o = p.child("bsdf", "", true); o != nullptr; o = p.child("bsdf", "", true)) {
       if (o->id.empty()) fail(*o, "a <bsdf> at the scene's top level needs an id, to be referenced by shapes");
-      material_name(*o);
     }
     for (const Object* o = p.child("texture", "", true); o != nullptr; o = p.child("texture", "", true)) {
       if (o->id.empty()) fail(*o, "a <texture> at the scene's top level needs an id");
@@ -559,6 +558,12 @@ class Converter {
       const Object* t = type == "normalmap" ? p.child("texture", "normalmap") : p.child("texture", "", true);
       if (t == nullptr) p.fail(type == "normalmap" ? "needs a <texture name=\"normalmap\">" : "needs a nested <texture>");
       const double scale = type == "bumpmap" ? p.number("scale", 1.0) : 1.0;
+      // wavetrace's own rule for a mapped normal facing away (docs/scene-format.md),
+      // and no shadowing term of the mapped normal's.
+      p.ignore("flip_invalid_normals");
+      if (p.boolean("use_shadowing_function", false)) {
+        warn(o, "use_shadowing_function: the mapped normal's shadowing term is not applied");
+      }
       p.finish();
       s = bsdf(*inner);
       if (s.material.value("type", "") == "emissive") p.fail("an emitter's surface takes no " + type);
@@ -601,7 +606,20 @@ class Converter {
           m["metal"] = it->second;
         }
       }
-      unit_reflectance(p, "specular_reflectance");
+      const bool tinted_mirror = m.contains("f0") && !p.nested("specular_reflectance") && p.has("specular_reflectance");
+      if (tinted_mirror) {
+        // Mitsuba's perfect mirror tinted: reflects the tint at every angle, where
+        // Schlick's f0 of the tint brightens towards grazing.
+        const Rgb tint = p.colour("specular_reflectance", Rgb{1, 1, 1});
+        if (tint.r > 1 || tint.g > 1 || tint.b > 1) p.fail("specular_reflectance must be at most 1");
+        if (tint.r != 1 || tint.g != 1 || tint.b != 1) {
+          m["f0"] = triple(tint);
+          warn(o, "specular_reflectance of material none is rendered as Schlick's f0 (the same at normal incidence, "
+                  "brighter towards grazing)");
+        }
+      } else {
+        unit_reflectance(p, "specular_reflectance");
+      }
       if (type == "roughconductor") {
         roughness(p, m, true);
       } else {
@@ -740,10 +758,9 @@ class Converter {
     materials_.push_back(s.material);
     return materials_of_[o] = {name, s.alpha};
   }
-  void material_name(const Object& o) { material(&o); }
-
   std::string emissive(const Object& emitter) {
     Plugin p(emitter);
+    p.ignore("sampling_weight");  // how often it is sampled, not what the image converges to
     json m = {{"type", "emissive"}};
     if (const Object* t = p.child("texture", "radiance")) {
       m["emission"] = triple(1, 1, 1);
@@ -758,6 +775,16 @@ class Converter {
     m["name"] = name;
     materials_.push_back(m);
     return name;
+  }
+
+  // A BSDF that reflects nothing (a diffuse or conductor of reflectance 0): an
+  // emitter's surface as wavetrace's emitters are.
+  static bool black(const Object& b) {
+    if (b.type == "twosided" && b.children.size() == 1) return black(*b.children[0]);
+    const char* key = b.type == "diffuse" ? "reflectance" : (b.type == "conductor" ? "specular_reflectance" : nullptr);
+    const Property* p = key != nullptr ? b.find(key) : nullptr;
+    const Rgb* c = p != nullptr ? std::get_if<Rgb>(&p->value) : nullptr;
+    return c != nullptr && c->r == 0 && c->g == 0 && c->b == 0;
   }
 
   // ---- emitters ----
@@ -888,7 +915,9 @@ class Converter {
       if (emitter->type != "area") fail(*emitter, "only an area emitter can be attached to a shape");
       if (group != nullptr) fail(*emitter, "an emitter in a shapegroup is not supported");
       material = emissive(*emitter);
-      if (b != nullptr) warn(o, "an area light's surface emits and does not also reflect (its bsdf is not rendered)");
+      if (b != nullptr && !black(*b)) {
+        warn(o, "an area light's surface emits and does not also reflect (its bsdf is not rendered)");
+      }
     } else {
       std::tie(material, alpha) = this->material(b);
     }
