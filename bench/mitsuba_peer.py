@@ -2714,7 +2714,9 @@ def cmd_render(args):
             os.makedirs(os.path.dirname(os.path.abspath(base)), exist_ok=True)
             mi.util.write_bitmap(base + ".exr", img)
             mi.util.write_bitmap(base + ".png", img)
-            rec["images"] = [base + ".exr", base + ".png"]
+            # RGB floats for readers without OpenEXR (bench/mitsuba_xml_tables.py).
+            mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).write(base + ".pfm")
+            rec["images"] = [base + ".exr", base + ".png", base + ".pfm"]
         print("%s %s %dx%d %d spp depth %d: %s s (median %.4f s), %.1f M paths/s"
               % (os.path.basename(args.scene), mode, s["width"], s["height"], s["spp"], s["depth"],
                  " ".join("%.4f" % x for x in seconds), med, paths / med / 1e6))

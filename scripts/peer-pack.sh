@@ -75,9 +75,15 @@ for f in "$mi"/plugins/*.so; do
 done
 # Headers, CMake files, type stubs, tests, byte code; spectral data (srgb.coeff is the
 # spectral variants' RGB upsampling table), conductor IOR tables (the converter's
-# conductors are material 'none' or give eta and k as RGB values) and sun-sky tables.
+# conductors are material 'none' or give eta and k as RGB values) and sun-sky tables;
+# but the tables of the metals that Mitsuba scenes may name by `material` and
+# wavetrace maps onto its presets (docs/scene-format.md, "Mitsuba 3 scenes").
+kept_ior=$build/kept-ior
+rm -rf "$kept_ior" && mkdir -p "$kept_ior"
+for metal in Au Ag Cu Al Cr Ni_palik; do cp "$mi"/data/ior/"$metal".*.spd "$kept_ior/"; done
 rm -rf "$mi/include" "$mi/cmake" "$mi/mitsuba_stubs" "$mi/python/test" "$mi/data" \
        "$dj/include" "$dj/cmake"
+mkdir -p "$mi/data/ior" && cp "$kept_ior"/*.spd "$mi/data/ior/"
 find "$tree" \( -name '__pycache__' -o -name '*.pyi' -o -name 'py.typed' -o -name 'stubs.pat' \) -prune \
   -exec rm -rf {} +
 # libembree3.so stays: libmitsuba.so (and every plugin) lists it as DT_NEEDED, so
@@ -140,6 +146,15 @@ EOF
           --variant llvm_ad_rgb --mode both --width 32 --height 18 --spp 2 --warmup 0 --repeats 1 \
           >"$build/check-$scene.log" 2>&1; then
         echo "peer-pack: $scene does not render with the trimmed package (see $build/check-$scene.log)" >&2
+        status=1
+      fi
+    done
+    # The Mitsuba scenes (scenes/mitsuba/), rendered as they are, at 2 spp.
+    for xml in "$root"/scenes/mitsuba/*.xml; do
+      if ! PYTHONPATH=$check/site-packages "$py" "$root/bench/mitsuba_peer.py" render "$xml" \
+          --variant llvm_ad_rgb --mode symbolic --spp 2 --warmup 0 --repeats 1 \
+          >"$build/check-$(basename "$xml").log" 2>&1; then
+        echo "peer-pack: $xml does not render with the trimmed package (see $build/check-$(basename "$xml").log)" >&2
         status=1
       fi
     done

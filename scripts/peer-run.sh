@@ -89,7 +89,8 @@ for scene in "${scenes[@]}"; do
   args+=(--seed 1)
   file=scenes/$scene.json
   [[ -f "$file" ]] || file=$scene
-  name=$(basename "$file" .json)
+  name=$(basename "$file")
+  name=${name%.*}  # .json, or a Mitsuba scene's .xml (rendered as it is)
   extra=()
   [[ "${PEER_KERNEL_HISTORY:-0}" == 1 ]] && extra+=(--kernel-history)
   [[ -n "${PEER_ARGS:-}" ]] && read -r -a args <<<"$PEER_ARGS"
