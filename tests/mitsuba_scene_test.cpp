@@ -187,8 +187,7 @@ TEST_F(MitsubaScene, BsdfsMapOntoWavetracesModelsAsDocumented) {
   EXPECT_DOUBLE_EQ(num(m["roughness"]), 0.4);
   EXPECT_DOUBLE_EQ(num(m["ior"]), 1.5);
   // Without nonlinear (Mitsuba's default) the base is a / (1 - R_int); wavetrace's
-  // a' / (1 - a' R_int) equals it for a' = a / (1 - R_int + a R_int): darker, as
-  // wavetrace's model already sums the coat's inner bounces in proportion to a.
+  // a' / (1 - a' R_int) equals it for a' = a / (1 - R_int + a R_int).
   m = material(R"(<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.5"/><float name="int_ior" value="1.5"/>
     <float name="ext_ior" value="1"/></bsdf>)");
   const double a = num(m["albedo"][0]);

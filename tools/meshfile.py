@@ -154,17 +154,23 @@ def write_glb(path, parts, mesh_name="mesh"):
     return sum(p.triangle_count for p in parts)
 
 
+def _file_and_complaint(path):
+    """A file's bytes, and a function that raises ValueError naming the file."""
+    with open(path, "rb") as f:
+        data = f.read()
+
+    def bad(msg):
+        raise ValueError("%s: %s" % (path, msg))
+    return data, bad
+
+
 def check_glb(path):
     """Re-reads a GLB and checks it: the header and its length, the two chunks,
     every buffer view inside the buffer, every accessor's byte length equal to
     its view's, POSITION min/max equal to the data's, every index inside the
     vertex range, unit normals. Returns (triangles, vertices); raises
     ValueError naming what is wrong."""
-    with open(path, "rb") as f:
-        data = f.read()
-
-    def bad(msg):
-        raise ValueError("%s: %s" % (path, msg))
+    data, bad = _file_and_complaint(path)
 
     if len(data) < 20:
         bad("too short")
@@ -600,11 +606,7 @@ def read_ply(path):
     list of uchar count and int/uint indices; ASCII or binary little endian).
     Returns {positions, normals, uvs, triangles} as flat arrays (None where
     absent); raises ValueError naming what is wrong, as check_glb does."""
-    with open(path, "rb") as f:
-        data = f.read()
-
-    def bad(msg):
-        raise ValueError("%s: %s" % (path, msg))
+    data, bad = _file_and_complaint(path)
 
     end = data.find(b"end_header\n")
     if not data.startswith(b"ply\n") or end < 0:
@@ -671,11 +673,7 @@ def read_serialized(path):
     a list of {name, positions, normals, uvs, triangles, double} (flat arrays,
     None where absent); raises ValueError naming what is wrong: a count that
     disagrees with the inflated size, an index out of range, a bad table."""
-    with open(path, "rb") as f:
-        data = f.read()
-
-    def bad(msg):
-        raise ValueError("%s: %s" % (path, msg))
+    data, bad = _file_and_complaint(path)
 
     if len(data) < 8:
         bad("too short")
