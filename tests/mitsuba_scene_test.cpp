@@ -380,6 +380,14 @@ TEST_F(MitsubaScene, WhatIsNotSupportedIsOneLineNamingTheFileAndTheLine) {
     EXPECT_NE(message.find(c.message), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
+  const std::string old_format = write("o.xml", "<scene version=\"0.6.0\"><shape type=\"rectangle\"/></scene>");
+  try {
+    read_mitsuba_scene(old_format);
+    ADD_FAILURE() << "a Mitsuba 0.6 scene was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("o.xml:1: scene: version 0.6.0: a Mitsuba 0.x scene"), std::string::npos)
+        << e.what();
+  }
   const std::string no_sensor = write("n.xml", "<scene version=\"3.0.0\"><shape type=\"rectangle\"/></scene>");
   EXPECT_THROW(read_mitsuba_scene(no_sensor), InputError);
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <set>
@@ -210,7 +211,14 @@ class Converter {
 
   json run() {
     Plugin p(scene_);
-    p.ignore("version");
+    // Mitsuba 0.x's files name their parameters otherwise (maxDepth, intIOR): Mitsuba 3
+    // reads them by upgrading them first, which wavetrace does not.
+    const std::string version = p.string("version", "3.0.0");
+    if (std::atoi(version.c_str()) < 2) {
+      p.fail("version " + version + ": a Mitsuba 0.x scene, whose parameter names wavetrace does not read (give "
+             "a Mitsuba 3 scene, version=\"3.0.0\")",
+             scene_.find("version")->line);
+    }
     const Object* sensor = p.child("sensor", "", true);
     if (sensor == nullptr) p.fail("the scene has no <sensor> (wavetrace needs its camera)");
     if (const Object* other = p.child("sensor", "", true)) fail(*other, "a second sensor is not supported (one camera a scene)");

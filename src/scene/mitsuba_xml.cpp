@@ -164,6 +164,11 @@ class Reader {
     if (std::string(root.name()) != "scene") {
       fail(Where{path, doc->line_of(root)}, root.name(), "the document's root must be <scene>");
     }
+    // The main file's format version, as the scene's property "version" (a string).
+    if (into.tag == "scene" && into.find("version") == nullptr && root.attribute("version")) {
+      into.properties.push_back(Property{"version", std::string(root.attribute("version").value()), "string",
+                                         doc->line_of(root)});
+    }
     including_.push_back(key);
     read_children(*doc, root, into);
     including_.pop_back();
