@@ -33,7 +33,7 @@ class CheckpointTest : public testing::Test {
 
   Checkpoint sample_checkpoint() const {
     Checkpoint c;
-    c.identity = checkpoint_identity(scene_, RenderParams{4, 2, 16, 8, 3, 7}, "wavefront", "cpu");
+    c.identity = checkpoint_identity(scene_, {}, RenderParams{4, 2, 16, 8, 3, 7}, "wavefront", "cpu");
     c.samples = 5;
     for (int i = 0; i < 4 * 2 * 3; ++i) c.film.push_back(0.25f * i);
     return c;
@@ -181,6 +181,12 @@ TEST_F(CheckpointTest, AnotherSceneSettingsOrKernelIsRefused) {
   now = then;
   now.renderer = "wavetrace 0.1";
   EXPECT_NE(refusal_of(now).find("made by " + then.renderer), std::string::npos);
+  // A Mitsuba scene's parameters are part of the scene: another -D is another scene.
+  now = checkpoint_identity(scene_, {{"spp", "64"}}, then.params, then.kernel, then.backend);
+  EXPECT_NE(now.scene_crc, then.scene_crc);
+  EXPECT_NE(refusal_of(now).find("the checkpoint is of another render: scene "), std::string::npos);
+  EXPECT_NE(checkpoint_identity(scene_, {{"spp", "65"}}, then.params, then.kernel, then.backend).scene_crc,
+            now.scene_crc);
 }
 
 TEST_F(CheckpointTest, ARenderStoppedBySigtermResumesToTheUninterruptedImage) {

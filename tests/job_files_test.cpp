@@ -175,7 +175,7 @@ TEST_F(JobFiles, ACheckpointResumedAndWrittenBackToIsAllowed) {
   const JobOutcome first = run_job(small_job(path("first.pfm")));
   ASSERT_EQ(first.exit_code, 0) << first.message;
   Checkpoint c;
-  c.identity = checkpoint_identity(scene_, first.params, first.kernel, first.backend);
+  c.identity = checkpoint_identity(scene_, {}, first.params, first.kernel, first.backend);
   c.samples = 1;
   c.film.assign(16 * 9 * 3, 0.5f);
   write_checkpoint(path("c.ckpt"), c);

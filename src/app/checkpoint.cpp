@@ -181,9 +181,11 @@ void put_array(std::string& out, const std::vector<T>& values) {
 
 }  // namespace
 
-CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
-                                       const std::string& kernel, const std::string& backend) {
-  const std::string bytes = read_input_file(scene, input::kScene);
+CheckpointIdentity checkpoint_identity(const std::string& scene, const std::map<std::string, std::string>& defines,
+                                       const RenderParams& params, const std::string& kernel,
+                                       const std::string& backend) {
+  std::string bytes = read_input_file(scene, input::kScene);
+  for (const auto& [name, value] : defines) bytes += "\n-D " + name + "=" + value;
   CheckpointIdentity id;
   id.scene = scene;
   id.scene_crc = crc_of(bytes.data(), bytes.size());

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,12 @@ struct CheckpointIdentity {
 };
 
 // Reads the scene file and fills the identity; throws InputError if it cannot be read.
-CheckpointIdentity checkpoint_identity(const std::string& scene, const RenderParams& params,
-                                       const std::string& kernel, const std::string& backend);
+// A Mitsuba scene's parameters (-D) count as part of its bytes: the CRC is of the
+// file followed by a line "-D name=value" for each (none for a JSON scene, whose CRC
+// is its file's).
+CheckpointIdentity checkpoint_identity(const std::string& scene, const std::map<std::string, std::string>& defines,
+                                       const RenderParams& params, const std::string& kernel,
+                                       const std::string& backend);
 
 struct Checkpoint {
   CheckpointIdentity identity;

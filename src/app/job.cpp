@@ -356,7 +356,7 @@ void watch_checkpoint(const Job& job, const JobOutcome& out, RenderOptions& opti
   const RenderParams& rp = options.params;
   const std::string& path = checkpoint_of(job);
   lock = CheckpointLock(path);
-  CheckpointIdentity identity = checkpoint_identity(job.scene, rp, out.kernel, out.backend);
+  CheckpointIdentity identity = checkpoint_identity(job.scene, job.defines, rp, out.kernel, out.backend);
   identity.noise_threshold = out.noise_threshold;
   identity.min_spp = out.min_spp;
   const std::string from =
