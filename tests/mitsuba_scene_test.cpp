@@ -97,6 +97,14 @@ TEST_F(MitsubaScene, TheSensorIsTheCameraWithItsFieldOfViewOnTheAxisMitsubaMeasu
   EXPECT_NEAR(vfov("smaller", 200, 100), 60, 1e-9);             // y is the smaller
   EXPECT_NEAR(vfov("smaller", 100, 200), deg(t * 2), 1e-9);     // x is
   EXPECT_NEAR(vfov("larger", 200, 100), deg(t / 2), 1e-9);
+  // A focal length (Mitsuba's default 50mm): 35 mm film's diagonal angle on the film's
+  // diagonal. Mitsuba 3.7.1 gives x_fov 38.1848 degrees for 50mm on 400 x 300.
+  const std::string focal = "<scene version=\"3.0.0\"><sensor type=\"perspective\">"
+                            "<film type=\"hdrfilm\"><integer name=\"width\" value=\"400\"/><integer name=\"height\" "
+                            "value=\"300\"/><rfilter type=\"box\"/></film></sensor><shape type=\"rectangle\"/></scene>";
+  const double vertical = num(read_mitsuba_scene(write("l.xml", focal))["camera"]["vfov"]);
+  const double x_fov = 2 * std::atan(std::tan(vertical / 2 * M_PI / 180) * 4 / 3) * 180 / M_PI;
+  EXPECT_NEAR(x_fov, 38.1848, 1e-4);
 }
 
 TEST_F(MitsubaScene, AThinLensGivesTheApertureAsADiameterAndItsFocus) {

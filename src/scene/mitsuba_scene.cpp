@@ -298,10 +298,26 @@ class Converter {
     if (dot(left, cross(up, forward)) <= 0) {
       p.fail("to_world mirrors the image (its determinant is negative): a mirrored camera is not supported");
     }
-    if (p.has("focal_length")) p.fail("'focal_length' is not supported: give 'fov'");
-    const double fov = p.number("fov", -1);
-    if (!(fov > 0 && fov < 180)) p.fail("'fov' is required, in (0, 180) degrees");
-    const std::string axis = p.string("fov_axis", "x");
+    double fov = 0;
+    std::string axis;
+    if (p.has("fov")) {
+      if (p.has("focal_length")) p.fail("give 'fov' or 'focal_length', not both");
+      fov = p.number("fov", -1);
+      if (!(fov > 0 && fov < 180)) p.fail("'fov' must be in (0, 180) degrees");
+      axis = p.string("fov_axis", "x");
+    } else {
+      // A 35 mm film's focal length (default 50mm): the angle its diagonal (36 x 24
+      // mm) spans, on the film's diagonal, as Mitsuba reads it.
+      const std::string given = p.string("focal_length", "50mm");
+      char* end = nullptr;
+      const double f = std::strtod(given.c_str(), &end);
+      if (!(f > 0) || !(std::string(end) == "mm" || std::string(end).empty())) {
+        p.fail("focal_length '" + given + "' is not a length in mm (\"50mm\")");
+      }
+      fov = 2 * std::atan(std::sqrt(36.0 * 36.0 + 24.0 * 24.0) / (2 * f)) * kDegrees;
+      axis = "diagonal";
+      p.ignore("fov_axis");
+    }
     const double t = std::tan(fov / 2 / kDegrees), w = width, h = height;
     double tv = t;
     if (axis == "x" || (axis == "smaller" && w <= h) || (axis == "larger" && w > h)) {
