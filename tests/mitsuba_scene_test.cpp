@@ -299,6 +299,10 @@ TEST_F(MitsubaScene, ShapesBecomeMeshesPlacedByInstancesAndSpheresStayAnalytic) 
     <shape type="shapegroup" id="g"><shape type="disk"><transform name="to_world"><translate y="1"/></transform></shape></shape>
     <shape type="instance"><ref id="g"/><transform name="to_world"><translate x="5"/></transform></shape>
     <shape type="instance"><ref id="g"/><transform name="to_world"><scale value="2"/></transform></shape>)");
+  // A BSDF referenced under a name of its own is the one BSDF.
+  const json named = mapped(R"(<bsdf type="diffuse" id="grey"/>
+    <shape type="rectangle"><ref id="grey" name="bsdf"/></shape><shape type="cube"><ref id="grey"/></shape>)");
+  EXPECT_EQ(named["materials"].size(), 1u);
   // One mesh entry per file and set of options: the two OBJ shapes share one.
   ASSERT_EQ(doc["meshes"].size(), 3u);
   EXPECT_EQ(doc["meshes"][0]["file"], "m.obj");

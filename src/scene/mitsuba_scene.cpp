@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
@@ -277,6 +278,12 @@ class Converter {
     return name;
   }
 
+  // What makes two objects one: the id it was given (a <ref> with a name of its own
+  // is a copy of the object, the same object all the same), else the object itself.
+  static std::string identity_of(const Object& o) {
+    return o.id.empty() ? "at:" + std::to_string(reinterpret_cast<uintptr_t>(&o)) : "id:" + o.id;
+  }
+
   static std::string label(const Object& o) {
     return o.id.empty() ? o.type + "@" + fs::path(o.file).filename().string() + ":" + std::to_string(o.line) : o.id;
   }
@@ -441,7 +448,7 @@ class Converter {
   // The texture `o` as a wavetrace texture's name. `linear`: where it holds vectors
   // or heights (a normal or bump map), whose bitmap must be read raw.
   std::string texture_name(const Object& o, bool linear, const std::string& use) {
-    const auto key = std::make_pair(&o, linear);
+    const auto key = std::make_pair(identity_of(o), linear);
     if (auto it = textures_of_.find(key); it != textures_of_.end()) return it->second;
     Plugin p(o);
     json t;
@@ -774,13 +781,13 @@ class Converter {
       }
       return {default_material_, json()};
     }
-    const auto it = materials_of_.find(o);
+    const auto it = materials_of_.find(identity_of(*o));
     if (it != materials_of_.end()) return it->second;
     Surface s = bsdf(*o);
     const std::string name = unique(label(*o));
     s.material["name"] = name;
     materials_.push_back(s.material);
-    return materials_of_[o] = {name, s.alpha};
+    return materials_of_[identity_of(*o)] = {name, s.alpha};
   }
   std::string emissive(const Object& emitter) {
     Plugin p(emitter);
@@ -917,17 +924,17 @@ class Converter {
         read_shape(*s, identity(), &members);
       }
       p.finish();
-      groups_[&o] = members;
+      groups_[identity_of(o)] = members;
       return;
     }
     if (type == "instance") {
       if (group != nullptr) p.fail("an instance within a shapegroup is not supported");
       const Object* g = p.child("shape", "", true);
       if (g == nullptr || g->type != "shapegroup") p.fail("needs a <ref> to a shapegroup");
-      if (!groups_.count(g)) read_shape(*g, identity(), nullptr);
+      if (!groups_.count(identity_of(*g))) read_shape(*g, identity(), nullptr);
       const Matrix m = multiply(parent, p.transform("to_world"));
       p.finish();
-      for (const auto& [name, own] : groups_.at(g)) place(name, multiply(m, own));
+      for (const auto& [name, own] : groups_.at(identity_of(*g))) place(name, multiply(m, own));
       return;
     }
     const Matrix m = multiply(parent, p.transform("to_world"));
@@ -1019,10 +1026,10 @@ class Converter {
        instances_ = json::array(), lights_ = json::array();
   std::vector<std::string> warnings_;
   std::set<std::string> used_names_;
-  std::map<std::pair<const Object*, bool>, std::string> textures_of_;
-  std::map<const Object*, std::pair<std::string, json>> materials_of_;
+  std::map<std::pair<std::string, bool>, std::string> textures_of_;
+  std::map<std::string, std::pair<std::string, json>> materials_of_;
   std::map<std::string, std::string> meshes_of_;
-  std::map<const Object*, std::vector<std::pair<std::string, Matrix>>> groups_;
+  std::map<std::string, std::vector<std::pair<std::string, Matrix>>> groups_;
   std::string default_material_;
   bool have_sky_ = false;
 };
