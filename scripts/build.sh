@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, then configures and builds wavetrace into build/
-# (or $WAVETRACE_BUILD).
+# (or $WAVETRACE_BUILD): every target, or only those named (scripts/wavetrace names
+# `wavetrace`, so the first render builds no test).
+#   scripts/build.sh [TARGET...]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build=${WAVETRACE_BUILD:-$root/build}
@@ -10,4 +12,6 @@ if [[ ! -f "$build/build.ninja" ]]; then
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" >/dev/null
 fi
 cuda_arch_configure "$build"
-cmake --build "$build" --parallel "$(nproc)"
+targets=()
+for t in "$@"; do targets+=(--target "$t"); done
+cmake --build "$build" --parallel "$(nproc)" "${targets[@]}"
