@@ -2525,25 +2525,26 @@ def to_xml(scene, base_dir):
     return "\n".join(lines) + "\n"
 
 
+def write_xml(conv, path, what):
+    """The conversion as the Mitsuba XML file `path`, headed by a comment: `what` the
+    scene was, and the notes of what does not map exactly. Raises XmlError."""
+    text = to_xml(conv.scene, os.path.dirname(os.path.abspath(path)))
+    notes = "".join("  - %s\n" % n.replace("--", "- -") for n in conv.notes)
+    header = "<!-- %s.%s -->\n" % (what, ("\n  What does not map exactly:\n" + notes) if notes else "")
+    _write_atomic(path, (header + text).encode("utf-8"))
+
+
 def cmd_xml(args):
     conv = convert(args.scene, **convert_kwargs(args))
     if conv.python_plugins:
         print("%s: needs Python plugins (%s), which XML cannot name" % (args.scene, ", ".join(conv.python_plugins)),
               file=sys.stderr)
         return 2
-    out_dir = os.path.dirname(os.path.abspath(args.output))
     try:
-        text = to_xml(conv.scene, out_dir)
+        write_xml(conv, args.output, "%s as a Mitsuba 3 scene (bench/mitsuba_peer.py xml)" % os.path.basename(args.scene))
     except XmlError as e:
         print("%s: %s" % (args.scene, e), file=sys.stderr)
         return 2
-    notes = "".join("  - %s\n" % n.replace("--", "- -") for n in conv.notes)
-    header = "<!-- %s as a Mitsuba 3 scene (bench/mitsuba_peer.py xml).%s -->\n" % (
-        os.path.basename(args.scene), ("\n  What does not map exactly:\n" + notes) if notes else "")
-    tmp = args.output + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(header + text)
-    os.replace(tmp, args.output)
     return 0
 
 

@@ -19,15 +19,13 @@ import sys
 import numpy as np
 from PIL import Image
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import relmse  # noqa: E402
+
 
 def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4")
-    img = data.reshape(h, w, 3 if kind == b"PF" else 1)
-    return img[::-1].astype(np.float64)  # PFM rows run bottom to top
+    w, h, data = relmse.read_pfm(path)
+    return np.frombuffer(data, dtype=np.float32).reshape(h, w, 3)[::-1].astype(np.float64)  # rows bottom to top
 
 
 def srgb8(img):

@@ -319,9 +319,10 @@ TEST_F(JobTest, AJobsDefinesAreAMitsubaScenesParameters) {
     {"scene": "s.xml", "output": "a.png", "defines": {"albedo": "0.5, 0.2, 0.1", "n": 3}},
     {"scene": "s.xml", "output": "b.png"},
     {"scene": "s.xml", "output": "c.png", "defines": {"bad name": "1"}},
-    {"scene": "s.xml", "output": "d.png", "defines": {"x": [1]}}]})");
+    {"scene": "s.xml", "output": "d.png", "defines": {"x": [1]}},
+    {"scene": "s.xml", "output": "e.png", "defines": {"a=b": "1"}}]})");
   std::vector<PlannedJob> planned = read_jobs_file(jobs, Job{});
-  ASSERT_EQ(planned.size(), 4u);
+  ASSERT_EQ(planned.size(), 5u);
   EXPECT_EQ(planned[0].error, "");
   // A job's defines replace the defaults' whole, as any key does.
   EXPECT_EQ(planned[0].job.defines, (std::map<std::string, std::string>{{"albedo", "0.5, 0.2, 0.1"}, {"n", "3"}}));
@@ -329,6 +330,8 @@ TEST_F(JobTest, AJobsDefinesAreAMitsubaScenesParameters) {
   EXPECT_NE(planned[2].error.find("/jobs/2/defines/bad name: a parameter's name is letters, digits and _"), std::string::npos)
       << planned[2].error;
   EXPECT_NE(planned[3].error.find("/jobs/3/defines/x: must be a string or a number"), std::string::npos) << planned[3].error;
+  EXPECT_NE(planned[4].error.find("/jobs/4/defines/a=b: a parameter's name is letters, digits and _"), std::string::npos)
+      << planned[4].error;
 }
 
 TEST_F(JobTest, SceneFilesAndRenderSettingsShareTheRanges) {

@@ -58,12 +58,9 @@ def round_trip(name, cache):
             for v in d:
                 walk(v)
     walk(conv.scene)
-    notes = "".join("  - %s\n" % n.replace("--", "- -") for n in conv.notes)
-    text = ("<!-- scenes/%s.json as a Mitsuba 3 scene, written by tools/make_mitsuba_scenes.py through "
-            "bench/mitsuba_peer.py's converter.%s -->\n" % (name, ("\n  What does not map exactly:\n" + notes) if notes
-                                                              else "")) + mp.to_xml(conv.scene, OUT)
-    with open(os.path.join(OUT, name + ".xml"), "w", encoding="utf-8") as f:
-        f.write(text)
+    mp.write_xml(conv, os.path.join(OUT, name + ".xml"),
+                 "scenes/%s.json as a Mitsuba 3 scene, written by tools/make_mitsuba_scenes.py through "
+                 "bench/mitsuba_peer.py's converter" % name)
 
 
 def showcase_meshes():

@@ -1,6 +1,5 @@
 #include "app/cli.hpp"
 
-#include <cctype>
 #include <cstdio>
 
 #include "errors/errors.hpp"
@@ -22,12 +21,7 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
            s.flag, [&job, id = s.id](int64_t v) { set_setting(job, id, v); }, s.help)
         ->check(CLI::Range(s.lo, s.hi));
   }
-  cmd.add_option_function<std::vector<std::string>>(
-         "-D,--define", [&job](const std::vector<std::string>& defines) { add_defines(job, defines, "-D"); },
-         "a Mitsuba scene's parameter: -D name=value (repeatable; before its <default>)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false);
+  add_define_option(cmd, job);
   cmd.add_option("--backend", job.backend, "cuda, cpu or auto (CUDA when a device is present)")
       ->check(CLI::IsMember(backend_choices()));
   cmd.add_option("--kernel", job.kernel, "the kernel: " + listed(kernel_names()))
@@ -49,6 +43,15 @@ void add_render_options(CLI::App& cmd, Job& job, std::string& encoding) {
   cmd.add_option("--aov", job.aov,
                  "write these AOVs too, comma-separated: " + listed(aov_names()) +
                      " (layers of an .exr output, else NAME.<aov>.pfm beside it)");
+}
+
+void add_define_option(CLI::App& cmd, Job& job) {
+  cmd.add_option_function<std::vector<std::string>>(
+         "-D,--define", [&job](const std::vector<std::string>& defines) { add_defines(job, defines, "-D"); },
+         "a Mitsuba scene's parameter: -D name=value (repeatable; before its <default>)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->allow_extra_args(false);
 }
 
 void set_encoding(Job& job, const std::string& encoding) {

@@ -15,6 +15,8 @@ namespace wt::app {
 // `encoding` (apply it with set_encoding). Names, ranges and help of the numeric
 // settings come from the settings table.
 void add_render_options(CLI::App& cmd, Job& job, std::string& encoding);
+// `-D name=value` (repeatable), a Mitsuba scene's parameters, into job.defines.
+void add_define_option(CLI::App& cmd, Job& job);
 void set_encoding(Job& job, const std::string& encoding);
 
 // The `render` subcommand: what it parses lands in `job`, `encoding` and `quiet`;

@@ -7,7 +7,7 @@
 #include "errors/errors.hpp"
 #include "image/image_io.hpp"
 #include "scene/mitsuba_scene.hpp"
-#include "scene/scene.hpp"
+#include "scene/scene_file.hpp"
 
 namespace wt::app {
 
@@ -20,7 +20,7 @@ int run_convert(const std::string& input, const std::string& output, const std::
     check_output_folder(output);
     nlohmann::json document = mitsuba::read_mitsuba_scene(input, defines);
     // The document as the XML's folder reads it is a scene: checked by loading it.
-    parse_scene(document.dump(), input);
+    scene_from_document(document, input);
     const fs::path from = fs::path(input).parent_path(), to = fs::path(output).parent_path();
     mitsuba::rebase_paths(document, from.empty() ? "." : from.string(), to.empty() ? "." : to.string());
     write_file(output, document.dump(2) + "\n");

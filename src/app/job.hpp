@@ -116,6 +116,8 @@ void set_setting(Job& job, SettingId id, int64_t value);
 // Adds "name=value" parameters of a Mitsuba scene to job.defines (a later one of a
 // name wins); throws InputError "<where>: ..." for one that is not name=value.
 void add_defines(Job& job, const std::vector<std::string>& defines, const std::string& where);
+// Whether `name` may name a parameter: letters, digits and _, at least one.
+bool is_define_name(const std::string& name);
 // A setting the job was given: its value, or none where the job keeps the default.
 std::optional<int64_t> given_setting(const Job& job, SettingId id);
 

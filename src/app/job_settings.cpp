@@ -2,6 +2,7 @@
 // description, which needs no renderer.
 #include "app/job.hpp"
 
+#include <algorithm>
 #include <cctype>
 
 namespace wt::app {
@@ -58,14 +59,19 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id) {
   }
 }
 
+bool is_define_name(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  });
+}
+
 void add_defines(Job& job, const std::vector<std::string>& defines, const std::string& where) {
   for (const std::string& d : defines) {
     const size_t eq = d.find('=');
-    const std::string name = d.substr(0, eq);
-    bool plain = eq != std::string::npos && !name.empty();
-    for (char c : name) plain = plain && (std::isalnum(static_cast<unsigned char>(c)) || c == '_');
-    if (!plain) throw InputError(where + ": '" + d + "' is not name=value (a name of letters, digits and _)");
-    job.defines[name] = d.substr(eq + 1);
+    if (eq == std::string::npos || !is_define_name(d.substr(0, eq))) {
+      throw InputError(where + ": '" + d + "' is not name=value (a name of letters, digits and _)");
+    }
+    job.defines[d.substr(0, eq)] = d.substr(eq + 1);
   }
 }
 

@@ -70,11 +70,8 @@ void apply_fields(const JsonReader& r, const json& obj, const JsonPath& path, co
       job.defines.clear();
       for (auto d = value.begin(); d != value.end(); ++d) {
         if (!d.value().is_string() && !d.value().is_number()) r.fail_at(at / d.key(), "must be a string or a number");
-        try {
-          add_defines(job, {d.key() + "=" + (d.value().is_string() ? d.value().get<std::string>() : d.value().dump())}, "");
-        } catch (const InputError&) {
-          r.fail_at(at / d.key(), "a parameter's name is letters, digits and _");
-        }
+        if (!is_define_name(d.key())) r.fail_at(at / d.key(), "a parameter's name is letters, digits and _");
+        job.defines[d.key()] = d.value().is_string() ? d.value().get<std::string>() : d.value().dump();
       }
     } else if (key == "aov") {
       job.aov = r.string(value, at);

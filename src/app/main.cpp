@@ -224,12 +224,7 @@ int run(int argc, char** argv, const Cluster& cluster) {
   CLI::App* convert = app.add_subcommand("convert", "write a Mitsuba 3 scene (.xml) as the wavetrace scene (.json) it is read as");
   convert->add_option("scene", convert_job.scene, "the Mitsuba scene (.xml)")->required();
   convert->add_option("-o,--output", convert_output, "the wavetrace scene to write (.json)")->required();
-  convert->add_option_function<std::vector<std::string>>(
-             "-D,--define", [&convert_job](const std::vector<std::string>& d) { wt::app::add_defines(convert_job, d, "-D"); },
-             "a scene parameter: -D name=value (repeatable)")
-      ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
-      ->allow_extra_args(false);
+  wt::app::add_define_option(*convert, convert_job);
   std::string kernels_backend;
   CLI::App* kernels = app.add_subcommand("kernels", "list the kernels, one a line, in the order the docs use");
   kernels->add_option("--backend", kernels_backend, "only those that run on this backend: cuda or cpu")

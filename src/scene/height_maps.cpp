@@ -6,9 +6,7 @@
 
 namespace wt {
 
-namespace {
-
-float height_of(const float* texel, HeightChannel channel) {
+float channel_of(const float* texel, HeightChannel channel) {
   switch (channel) {
     case HeightChannel::Luminance: return 0.2126f * texel[0] + 0.7152f * texel[1] + 0.0722f * texel[2];
     case HeightChannel::Red: return texel[0];
@@ -18,6 +16,8 @@ float height_of(const float* texel, HeightChannel channel) {
   }
   return 0.0f;
 }
+
+namespace {
 
 // h's derivative at index i of n along one axis, per unit of the coordinate (n
 // texels), from the texels either side (get(j)) as the wrap finds them: a
@@ -38,7 +38,7 @@ Image height_gradient(const Image& height, HeightChannel channel, Wrap wrap_u, W
   out.height = height.height;
   const int w = height.width, h = height.height;
   std::vector<float> heights(static_cast<size_t>(w) * h);
-  for (size_t i = 0; i < heights.size(); ++i) heights[i] = height_of(&height.texels[4 * i], channel);
+  for (size_t i = 0; i < heights.size(); ++i) heights[i] = channel_of(&height.texels[4 * i], channel);
   out.texels.assign(heights.size() * 4, 0.0f);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {

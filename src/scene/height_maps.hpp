@@ -12,6 +12,9 @@ namespace wt {
 // linear values), or one of its channels.
 enum class HeightChannel { Luminance, Red, Green, Blue, Alpha };
 
+// That channel of an RGBA texel (four floats).
+float channel_of(const float* texel, HeightChannel channel);
+
 // The image of `height`'s derivatives, texel (x, y) holding (dh/du, dh/dv, 0, 1) in
 // height units per unit of the texture's coordinates (u across the image's width, v
 // down its rows): central differences of the texels either side, times the image's

@@ -70,16 +70,9 @@ void cylinder(IndexedMesh& m) {
 
 }  // namespace
 
-const char* const* shape_names() {
-  static const char* const names[] = {"rectangle", "cube", "disk", "cylinder", nullptr};
+const std::vector<std::string>& shape_names() {
+  static const std::vector<std::string> names = {"rectangle", "cube", "disk", "cylinder"};
   return names;
-}
-
-bool is_shape_name(const std::string& name) {
-  for (const char* const* n = shape_names(); *n != nullptr; ++n) {
-    if (name == *n) return true;
-  }
-  return false;
 }
 
 TriangleMesh shape_mesh(const std::string& name) {

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "scene/mesh_load.hpp"
 
@@ -25,8 +26,7 @@ constexpr int kDiskSegments = 1024;
 constexpr int kCylinderSegments = 1024;
 
 // The built-in shapes' names.
-const char* const* shape_names();  // null-terminated
-bool is_shape_name(const std::string& name);
+const std::vector<std::string>& shape_names();
 
 // The shape `name` (one of shape_names()); its source is "<shape name>".
 TriangleMesh shape_mesh(const std::string& name);

@@ -240,6 +240,7 @@ class Converter {
       read_shape(*o, identity(), nullptr);
     }
     p.finish();
+    doc_["render"] = render_;
     if (!have_sky_) doc_["sky"] = {{"type", "uniform"}, {"radiance", triple(0, 0, 0)}};
     if (!textures_.empty()) doc_["textures"] = textures_;
     doc_["materials"] = materials_;
@@ -353,7 +354,6 @@ class Converter {
     doc_["camera"] = camera;
     render_["width"] = width;
     render_["height"] = height;
-    doc_["render"] = render_;
   }
 
   void read_film(const Object& o, int& width, int& height) {
@@ -392,7 +392,6 @@ class Converter {
   }
 
   void read_integrator(const Object* o) {
-    render_ = doc_.value("render", json::object());
     int64_t depth = -1, rr = 5;
     if (o != nullptr) {
       Plugin p(*o);
@@ -422,7 +421,6 @@ class Converter {
     render_["depth"] = depth;
     render_["roulette_depth"] = rr;
     render_["nee"] = 1;
-    doc_["render"] = render_;
   }
 
   // ---- textures ----

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "scene/scene.hpp"
@@ -14,5 +15,9 @@ namespace wt {
 // Throws InputError naming the file (and the field, or the XML line); parameters
 // given for a JSON scene are an error.
 Scene load_scene(const std::string& path, const std::map<std::string, std::string>& defines);
+
+// A scene document already parsed (a Mitsuba scene's mapping), read as its file
+// `source` would be: relative paths from its folder, errors naming it.
+Scene scene_from_document(nlohmann::json document, const std::string& source);
 
 }  // namespace wt

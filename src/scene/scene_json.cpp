@@ -201,6 +201,8 @@ Scene load_scene(const std::string& path, const std::map<std::string, std::strin
 
 Scene load_scene(const std::string& path) { return load_scene(path, {}); }
 
+Scene scene_from_document(json document, const std::string& source) { return prepare(std::move(document), source, 0.0); }
+
 // Compact drops the misses before the sort, so only the materials' keys count.
 int Scene::sort_key_bits() const {
   uint32_t largest = 0;

@@ -2,11 +2,11 @@
 // a mesh by a transform, with an optional material).
 #include <glm/gtc/matrix_transform.hpp>
 
-#include <cctype>
+#include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <future>
 #include <limits>
+#include <optional>
 
 #include "scene/input_file.hpp"
 #include "scene/mesh_load.hpp"
@@ -42,8 +42,7 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     uint32_t shape_index = 0;
     int32_t material = -1;
     bool face_normals = false, flip_normals = false;
-    bool alpha = false;
-    AlphaTest alpha_test{};
+    std::optional<AlphaTest> alpha;
   };
   std::vector<Spec> specs;
   for (size_t i = 0; i < list.size(); ++i) {
@@ -57,10 +56,8 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     if (j.contains("shape") == j.contains("file")) fail_at(at, "give either \"file\" or \"shape\"");
     if (j.contains("shape")) {
       s.shape = string(j["shape"], at / "shape");
-      if (!is_shape_name(s.shape)) {
-        std::vector<std::string> names;
-        for (const char* const* n = shape_names(); *n != nullptr; ++n) names.emplace_back(*n);
-        fail_at(at / "shape", "unknown shape '" + s.shape + "' (expected " + listed(names) + ")");
+      if (std::find(shape_names().begin(), shape_names().end(), s.shape) == shape_names().end()) {
+        fail_at(at / "shape", "unknown shape '" + s.shape + "' (expected " + listed(shape_names()) + ")");
       }
     } else {
       s.file = (base_dir_ / string(j["file"], at / "file")).lexically_normal().string();
@@ -74,8 +71,7 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     if (j.contains("flip_normals")) s.flip_normals = boolean(j["flip_normals"], at / "flip_normals");
     if (j.contains("alpha")) {
       if (s.material < 0) fail_at(at / "alpha", "needs the mesh's \"material\" (a file's own materials carry their own alpha)");
-      s.alpha = true;
-      s.alpha_test = read_alpha(j["alpha"], at / "alpha");
+      s.alpha = read_alpha(j["alpha"], at / "alpha");
     }
     specs.push_back(std::move(s));
   }
@@ -108,7 +104,7 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   mesh_seconds_ += seconds_since(start);
   for (size_t i = 0; i < meshes.size(); ++i) {
     try {
-      add_mesh(meshes[i], specs[i].name, specs[i].material, specs[i].alpha ? &specs[i].alpha_test : nullptr);
+      add_mesh(meshes[i], specs[i].name, specs[i].material, specs[i].alpha ? &*specs[i].alpha : nullptr);
     } catch (const InputError& e) {  // a texture its materials name, its size
       throw InputError(source() + ": " + (path / i / "file").str() + ": " + e.what());
     }
@@ -137,7 +133,7 @@ AlphaTest SceneReader::read_alpha(const json& j, const JsonPath& path) {
       // an image of its own.
       Image im = scene_.images[static_cast<size_t>(t.image)];
       for (size_t k = 0; k + 3 < im.texels.size(); k += 4) {
-        im.texels[k + 3] = 0.2126f * im.texels[k] + 0.7152f * im.texels[k + 1] + 0.0722f * im.texels[k + 2];
+        im.texels[k + 3] = channel_of(&im.texels[k], HeightChannel::Luminance);
       }
       im.path += "#luminance";
       scene_.images.push_back(std::move(im));
