@@ -1303,6 +1303,17 @@ class Converter:
             b = self.plastic(m, on_sphere, to_object)
         elif kind == "principled":
             b = self.principled(m, on_sphere, to_object)
+        elif kind == "blend":
+            # Mitsuba's blendbsdf is the same mixture (its weight clamped to [0, 1],
+            # a texture's read by its luminance); it evaluates both BSDFs at a hit
+            # where wavetrace shades with one picked by the weight.
+            w = float(m.get("weight", 0.5))
+            weight = (self.texture(m["weight_texture"], [w, w, w], on_sphere, to_object)
+                      if "weight_texture" in m else w)
+            b = {"type": "blendbsdf", "weight": weight}
+            for i, name in enumerate(m["materials"]):
+                b["bsdf_%d" % i] = self.bsdf(self.materials[name], on_sphere, to_object)
+            return b
         else:
             raise ConversionError("unknown material type %s" % kind)
         if kind in ("conductor", "plastic") or (not on_sphere and kind in ("lambertian", "metal", "coated")):

@@ -84,15 +84,16 @@ struct Chi2 {
 // the centre where a sharp lobe is, and 32 azimuths), keeping only directions with
 // z of sign `side` (0: all). Counts the sampler's non-specular samples against n
 // times the density's integral over each bin (10 x 10 midpoints a bin).
-inline Chi2 chi2_test(const BsdfAt& b, const vec3& wo, const std::function<float(const vec3&)>& pdf, const vec3& centre,
-               int side, uint32_t seed) {
+// `sample(i)`: the sampler's i-th sample (of kSamples).
+inline Chi2 chi2_test(const std::function<BsdfSample(int)>& sample, const std::function<float(const vec3&)>& pdf,
+                      const vec3& centre, int side) {
   constexpr int kTheta = 48, kPhi = 32, kSub = 10;
   const Frame f = Frame::about(centre, vec3(0.3f, 0.7f, 0.1f));
   auto theta_edge = [](int i) { return kPiD * std::pow(static_cast<double>(i) / kTheta, 3.0); };
   auto on_side = [side](const vec3& w) { return side == 0 || (side > 0 ? w.z > 0.0f : w.z < 0.0f); };
   std::vector<double> observed(kTheta * kPhi, 0.0), expected(kTheta * kPhi, 0.0);
   for (int i = 0; i < kSamples; ++i) {
-    const BsdfSample s = sample_bsdf(b, wo, Rng::at(seed, static_cast<uint32_t>(i), 0, 0));
+    const BsdfSample s = sample(i);
     if (s.lobe == 0u || (s.lobe & kLobeSpecular) || !on_side(s.wi)) continue;
     const vec3 l = f.to_local(s.wi);
     // atan2 keeps small angles exact (acos of a float near 1 steps by 3.5e-4 rad).
@@ -152,6 +153,13 @@ inline Chi2 chi2_test(const BsdfAt& b, const vec3& wo, const std::function<float
   const double k = dof;
   const double z = (std::cbrt(chi2 / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
   return Chi2{chi2, dof, z, in_bins / kSamples};
+}
+
+// sample_bsdf's samples of b at wo (seed, i) against `pdf`.
+inline Chi2 chi2_test(const BsdfAt& b, const vec3& wo, const std::function<float(const vec3&)>& pdf, const vec3& centre,
+                      int side, uint32_t seed) {
+  return chi2_test([&](int i) { return sample_bsdf(b, wo, Rng::at(seed, static_cast<uint32_t>(i), 0, 0)); }, pdf,
+                   centre, side);
 }
 
 inline std::function<float(const vec3&)> pdf_of(const BsdfAt& b, const vec3& wo) {

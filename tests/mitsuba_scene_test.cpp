@@ -18,6 +18,7 @@
 #include "render_support.hpp"
 #include "scene/bsdf_tables.hpp"
 #include "scene/mesh_shapes.hpp"
+#include "scene/mitsuba_metals.hpp"
 #include "scene/scene_file.hpp"
 #include "test_support.hpp"
 #include "wavetrace/texture.hpp"
@@ -216,6 +217,43 @@ TEST_F(MitsubaScene, BsdfsMapOntoWavetracesModelsAsDocumented) {
   EXPECT_NEAR(num(beckmann["materials"][0]["roughness"]), std::sqrt(0.1), 1e-12);  // Mitsuba's default alpha
 }
 
+TEST_F(MitsubaScene, EveryNamedConductorOfMitsubaMaps) {
+  // Outside the six that map onto wavetrace's presets: the RGB eta and k Mitsuba's
+  // RGB variants load (scene/mitsuba_metals.hpp, tools/mitsuba_metals.py).
+  for (const std::string name : {"Hg", "a-C", "Cu_palik"}) {
+    const MitsubaMetal* row = nullptr;
+    for (const MitsubaMetal& metal : kMitsubaMetals) {
+      if (name == metal.name) row = &metal;
+    }
+    ASSERT_NE(row, nullptr) << name;
+    const json m = material("<bsdf type=\"roughconductor\"><string name=\"material\" value=\"" + name +
+                            "\"/><string name=\"distribution\" value=\"ggx\"/></bsdf>");
+    EXPECT_EQ(m["type"], "conductor") << name;
+    EXPECT_FALSE(m.contains("metal")) << name;
+    const auto numbers = [](const vec3& v) { return json::array({double(v.x), double(v.y), double(v.z)}); };
+    EXPECT_EQ(m["eta"], numbers(row->eta)) << name;
+    EXPECT_EQ(m["k"], numbers(row->k)) << name;
+  }
+  // The six keep wavetrace's presets and are not in the table; every row is one a
+  // JSON conductor takes (eta > 0, k >= 0).
+  EXPECT_EQ(material(R"(<bsdf type="conductor"><string name="material" value="Ni_palik"/></bsdf>)")["metal"], "nickel");
+  for (const MitsubaMetal& metal : kMitsubaMetals) {
+    for (const std::string own : {"Au", "Ag", "Cu", "Al", "Cr", "Ni_palik"}) EXPECT_NE(own, metal.name);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GT(metal.eta[c], 0.0f) << metal.name;
+      EXPECT_GE(metal.k[c], 0.0f) << metal.name;
+    }
+  }
+  // A name Mitsuba does not know: one line naming the file, the line and the six.
+  const std::string message = refusal(
+      "\n<shape type=\"rectangle\"><bsdf type=\"conductor\"><string name=\"material\" value=\"Unobtainium\"/></bsdf></shape>");
+  EXPECT_NE(message.find("s.xml:8: conductor: material 'Unobtainium' is not one of Mitsuba's named conductors "
+                         "(Ag, Al, Au, Cr, Cu, Ni_palik, "),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
 TEST_F(MitsubaScene, PrincipledMapsDisneysParametersWhereTheyMeanTheSame) {
   json m = material(R"(<bsdf type="principled"><rgb name="base_color" value="0.8, 0.2, 0.1"/><float name="metallic" value="0.3"/>
     <float name="roughness" value="0.6"/><float name="anisotropic" value="0.5"/><float name="spec_trans" value="0.4"/>
@@ -282,6 +320,45 @@ TEST_F(MitsubaScene, TexturesMaskNormalAndBumpMapsMap) {
   doc = mapped(R"(<shape type="rectangle"><bsdf type="mask"><texture type="bitmap" name="opacity">
       <string name="filename" value="t.png"/></texture><bsdf type="diffuse"/></bsdf></shape>)");
   EXPECT_EQ(doc["meshes"][0]["alpha"]["channel"], "luminance");
+}
+
+// blendbsdf: wavetrace's blend of its two BSDFs in order (the first at weight 0),
+// its weight a number or a texture (read by its luminance, as Mitsuba reads one).
+TEST_F(MitsubaScene, ABlendbsdfIsABlendOfItsTwoBsdfs) {
+  json doc = mapped(R"(<bsdf type="diffuse" id="grey"/><shape type="rectangle"><bsdf type="blendbsdf">
+      <float name="weight" value="0.3"/><ref id="grey"/><bsdf type="roughconductor"><string name="material" value="Au"/>
+      </bsdf></bsdf></shape>)");
+  ASSERT_EQ(doc["materials"].size(), 3u);
+  const json& blend = doc["materials"][2];
+  EXPECT_EQ(blend["type"], "blend");
+  EXPECT_EQ(blend["weight"], 0.3);
+  EXPECT_EQ(blend["materials"], json::array({doc["materials"][0]["name"], doc["materials"][1]["name"]}));
+  EXPECT_EQ(doc["materials"][0]["type"], "lambertian");
+  EXPECT_EQ(doc["materials"][1]["type"], "conductor");
+  EXPECT_EQ(doc["meshes"][0]["material"], blend["name"]);
+
+  doc = mapped(R"(<shape type="rectangle"><bsdf type="blendbsdf"><texture type="checkerboard" name="weight"/>
+      <bsdf type="diffuse"/><bsdf type="dielectric"/></bsdf></shape>)");
+  EXPECT_EQ(doc["materials"][2]["weight"], 1);
+  EXPECT_EQ(doc["materials"][2]["weight_texture"], doc["textures"][0]["name"]);
+  EXPECT_EQ(doc["textures"][0]["type"], "uv_checker");
+
+  // A mask around a blend masks the mesh; within one it is refused, as a normal map
+  // around one is (it would be its materials').
+  doc = mapped(R"(<shape type="rectangle"><bsdf type="mask"><float name="opacity" value="0.5"/><bsdf type="blendbsdf">
+      <bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)");
+  EXPECT_EQ(doc["meshes"][0]["alpha"]["opacity"], 0.5);
+  EXPECT_NE(refusal(R"(<shape type="rectangle"><bsdf type="blendbsdf"><bsdf type="mask"><bsdf type="diffuse"/></bsdf>
+      <bsdf type="diffuse"/></bsdf></shape>)").find("mask: a mask within a blendbsdf is not supported"), std::string::npos);
+  write("t.png", "");
+  EXPECT_NE(refusal(R"(<shape type="rectangle"><bsdf type="normalmap"><texture type="bitmap" name="normalmap">
+      <string name="filename" value="t.png"/><boolean name="raw" value="true"/></texture><bsdf type="blendbsdf">
+      <bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)").find("normalmap: a normalmap around a blendbsdf"),
+            std::string::npos);
+  EXPECT_NE(refusal(R"(<shape type="rectangle"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/>
+      <bsdf type="diffuse"/></bsdf></shape>)").find("blendbsdf: takes two nested BSDFs, not more"), std::string::npos);
+  EXPECT_NE(refusal(R"(<shape type="rectangle"><bsdf type="blendbsdf"><float name="weight" value="2"/><bsdf type="diffuse"/>
+      <bsdf type="diffuse"/></bsdf></shape>)").find("blendbsdf: weight must be in [0, 1]"), std::string::npos);
 }
 
 TEST_F(MitsubaScene, ShapesBecomeMeshesPlacedByInstancesAndSpheresStayAnalytic) {
@@ -378,9 +455,9 @@ TEST_F(MitsubaScene, WhatIsNotSupportedIsOneLineNamingTheFileAndTheLine) {
       {"\n<shape type=\"teapot\"/>", "s.xml:8: teapot: shape type 'teapot' is not supported"},
       {"\n<shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape>",
        "s.xml:8: obj: file 'missing.obj' does not exist"},
-      {"\n<shape type=\"rectangle\"><bsdf type=\"blendbsdf\"/></shape>", "s.xml:8: blendbsdf: a blend of two BSDFs is not supported"},
-      {"\n<shape type=\"rectangle\"><bsdf type=\"conductor\"><string name=\"material\" value=\"W\"/></bsdf></shape>",
-       "s.xml:8: conductor: material 'W' is not one wavetrace holds"},
+      {"\n<shape type=\"rectangle\"><bsdf type=\"blendbsdf\"/></shape>", "s.xml:8: blendbsdf: needs two nested BSDFs"},
+      {"\n<shape type=\"rectangle\"><bsdf type=\"conductor\"><string name=\"material\" value=\"Unobtainium\"/></bsdf></shape>",
+       "s.xml:8: conductor: material 'Unobtainium' is not one of Mitsuba's named conductors"},
       {"\n<shape type=\"rectangle\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>"
        "<float name=\"alpha_v\" value=\"0.3\"/></bsdf></shape>",
        "s.xml:8: roughconductor: alpha_v > alpha_u"},

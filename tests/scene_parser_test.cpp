@@ -420,7 +420,7 @@ TEST(SceneParser, UnknownTypesAreRejected) {
   EXPECT_EQ(error_of_text(with(doc, "/materials/2/type", "plastik").dump()),
             kSource +
                 ": /materials/2/type: unknown material type 'plastik' (expected lambertian, metal, dielectric, "
-                "coated, emissive, conductor, glass, plastic, principled)");
+                "coated, emissive, conductor, glass, plastic, principled, blend)");
   expect_error(with(doc, "/textures/1/type", "wood"), "/textures/1/type",
                "unknown texture type 'wood' (expected checker, noise, image, uv_checker)");
   expect_error(with(doc, "/sky/type", "hdri"), "/sky/type", "unknown sky type 'hdri' (expected gradient, uniform, environment)");

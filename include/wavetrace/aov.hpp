@@ -62,7 +62,7 @@ WT_HD WT_INLINE FirstSurface first_surface(const Scene& scene, const RenderParam
       out.depth = hit.t;
       out.position = ray.at(hit.t);
     }
-    const Material& m = scene.material(material_index<Kinds>(scene, hit));
+    const Material& m = scene.material(shading_material_index<Kinds>(scene, ray, hit));
     SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
     if (m.kind == MaterialKind::Emissive) {
       out.albedo = weight * clamp_unit(emitted_radiance<Kinds>(scene, m, ray, hit));

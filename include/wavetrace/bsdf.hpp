@@ -168,7 +168,8 @@ WT_HD WT_INLINE BsdfSample sample_bsdf(const BsdfAt& b, const vec3& wo, const Rn
     case MaterialKind::Principled:
       if constexpr (Microfacet) return principled_sample<Layers>(b, wo, rng);
       break;
-    case MaterialKind::Emissive: break;
+    case MaterialKind::Emissive:
+    case MaterialKind::Blend: break;  // a blend shades as the material it picks (blend.hpp)
   }
   return no_sample();
 }
@@ -207,7 +208,8 @@ WT_HD WT_INLINE vec3 eval_bsdf(const BsdfAt& b, const vec3& wo, const vec3& wi, 
       if constexpr (Microfacet) f = principled_eval<Layers>(b, wo, wi, pdf);
       break;
     case MaterialKind::Dielectric:
-    case MaterialKind::Emissive: break;
+    case MaterialKind::Emissive:
+    case MaterialKind::Blend: break;
   }
   if (WT_MUTANT(BsdfPdfScaled)) pdf *= 1.05f;
   return f;
@@ -236,7 +238,8 @@ WT_HD WT_INLINE bool bsdf_samples_lights(const BsdfAt& b) {
     case MaterialKind::Conductor: return Microfacet && !conductor_ggx(b).smooth();
     case MaterialKind::Glass: return Microfacet && !(b.flags & kMaterialThin) && !glass_ggx(b).smooth();
     case MaterialKind::Dielectric:
-    case MaterialKind::Emissive: break;
+    case MaterialKind::Emissive:
+    case MaterialKind::Blend: break;
   }
   return false;
 }

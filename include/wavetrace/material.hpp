@@ -18,8 +18,12 @@ enum class MaterialKind : uint8_t {
   Glass = 6,
   Plastic = 7,
   Principled = 8,
+  // Two materials mixed by a weight: not shaded itself. Each hit on it shades with
+  // one of the two, picked with the weight's probability (blend.hpp), so the image
+  // converges to the weighted sum of the two BSDFs.
+  Blend = 9,
 };
-constexpr uint32_t kMaterialKindCount = 9;
+constexpr uint32_t kMaterialKindCount = 10;
 
 // Material::flags.
 enum MaterialFlag : uint16_t {
@@ -88,6 +92,11 @@ struct MaterialParams {
   vec3 attenuation{0.0f};
   // A reflecting material's emission texture (Material::emission times its colour).
   int32_t emission_texture = -1;
+  // Blend: its two materials (indices into the scene's materials), the second taken
+  // with probability blend_weight, times blend_texture's luminance where it has one.
+  int32_t blend_materials[2] = {-1, -1};
+  float blend_weight = 0.5f;
+  int32_t blend_texture = -1;
 };
 
 // Kept at 44 bytes: the constant-memory megakernel holds every material of a
@@ -104,7 +113,7 @@ struct Material {
   vec3 albedo;      // Lambertian, Metal, Coated, Plastic (the base), Principled (the base colour);
                     // Dielectric, Glass: transmission tint
   vec3 emission;    // Emissive; any other kind with kMaterialEmits
-  int32_t params = -1;  // Conductor, Glass, Plastic: index into material_params (-1: none)
+  int32_t params = -1;  // Conductor, Glass, Plastic, Principled, Blend: index into material_params (-1: none)
 };
 static_assert(sizeof(Material) == 44, "a material grows every constant-memory scene");
 
@@ -115,7 +124,9 @@ static_assert(sizeof(Material) == 44, "a material grows every constant-memory sc
 // emitters, whose hits only add their emission; the miss key follows.
 //   lambertian 0-3, metal 4-7, dielectric 8, coated 12-15, conductor 16, glass 17,
 //   plastic 18-21, principled 22-25, emitters 26, misses 27.
-constexpr uint8_t kKindFirstKey[kMaterialKindCount] = {0, 4, 8, 12, 26, 16, 17, 18, 22};
+// A blend has no key of its own: a hit shades with the material it picks, under
+// that material's key (its slot here is never read).
+constexpr uint8_t kKindFirstKey[kMaterialKindCount] = {0, 4, 8, 12, 26, 16, 17, 18, 22, 26};
 constexpr uint32_t kEmitterSortKey = 26;
 WT_HD WT_INLINE uint32_t material_sort_key(MaterialKind kind, int texture_kind /* -1: none */) {
   const bool textured = kind == MaterialKind::Lambertian || kind == MaterialKind::Metal ||

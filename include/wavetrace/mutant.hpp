@@ -31,7 +31,8 @@ namespace wt {
   X(ShadowIgnoresFirstHit, "shadow-ignores-first-hit")                                        \
   X(VisibleNormalsWithoutG1, "visible-normals-without-g1") /* GGX's density of visible normals */ \
   X(GlassUnscaledRadiance, "glass-unscaled-radiance") /* rough transmission without 1 / eta^2 */ \
-  X(CompensationDropped, "compensation-dropped")  /* conductors' multiple-scattering lobe */
+  X(CompensationDropped, "compensation-dropped")  /* conductors' multiple-scattering lobe */ \
+  X(BlendWeightSwapped, "blend-weight-swapped")   /* a blend's pick takes the first for the second */
 
 enum class Mutant : int {
   None,

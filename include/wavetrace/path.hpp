@@ -2,6 +2,7 @@
 // transport that every backend and kernel runs.
 #pragma once
 
+#include "wavetrace/blend.hpp"
 #include "wavetrace/mutant.hpp"
 #include "wavetrace/scene_lights.hpp"
 #include "wavetrace/scene_view.hpp"
@@ -71,6 +72,33 @@ WT_HD WT_INLINE vec3 emitted_radiance(const Scene& scene, const Material& m, con
     sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
     return m.emission * eval_texture(scene.texture_array()[texture], scene.image_array(), sp);
   }
+}
+
+// The material that shades `hit`, reached along `ray`: material_index's, or where
+// that is a blend, the material it picks there (blend.hpp), level after level.
+// Intersect takes the sort key from it and shade the material, so that both pick
+// alike. A blend's weight texture is looked up as the BSDF's textures are, filtered
+// over the camera's footprint, and its luminance (clamped to [0, 1]) scales the weight.
+// Kinds without kMicrofacet: compiled for scenes without blends (a blend has params).
+template <uint32_t Kinds, class Scene>
+WT_HD WT_INLINE uint32_t shading_material_index(const Scene& scene, const Ray& ray, const Hit& hit) {
+  uint32_t index = material_index<Kinds>(scene, hit);
+  if constexpr ((Kinds & kMicrofacet) != 0) {
+    for (int level = 0; level < kMaxBlendDepth; ++level) {
+      const Material& m = scene.material(index);
+      if (m.kind != MaterialKind::Blend) break;
+      const MaterialParams& p = scene.material_param_array()[m.params];
+      float weight = p.blend_weight;
+      if (p.blend_texture >= 0) {
+        SurfacePoint sp = surface_at<Kinds>(scene, ray, hit);
+        sp.footprint = scene.camera.footprint(sp.p, sp.ng, ray.dir);
+        const float y = luminance(eval_texture(scene.texture_array()[p.blend_texture], scene.image_array(), sp));
+        weight *= fminf(fmaxf(y, 0.0f), 1.0f);
+      }
+      index = static_cast<uint32_t>(p.blend_materials[blend_takes_second(weight, blend_uniform(ray, hit, level)) ? 1 : 0]);
+    }
+  }
+  return index;
 }
 
 // The BSDF of material m at sp, reached along `ray`: its textures filtered over the
@@ -204,7 +232,7 @@ WT_HD WT_INLINE bool shade_hit(const Scene& scene, const RenderParams& rp, const
                                uint32_t sample, uint32_t bounce, Ray& ray, vec3& throughput, vec3& radiance,
                                float& pdf, ShadowRay& shadow) {
   shadow.valid = false;
-  const Material& m = scene.material(material_index<Kinds>(scene, hit));
+  const Material& m = scene.material(shading_material_index<Kinds>(scene, ray, hit));
   const bool nee = (Kinds & kLightSampling) != 0 && rp.nee != 0 && scene.light_count() > 0;
   constexpr bool kFacets = (Kinds & kMicrofacet) != 0;
   constexpr bool kLayers = kFacets && (Kinds & kLayersAndAlpha) != 0;

@@ -301,6 +301,10 @@ WT_HD WT_INLINE vec2 texture_uv(const Texture& t, vec2 uv) {
   return t.uv_offset + vec2(t.uv_cos * s.x + t.uv_sin * s.y, t.uv_cos * s.y - t.uv_sin * s.x);
 }
 
+// The luminance Y of a linear Rec. 709 colour (what a texture's value means where
+// one number is read from it: a height, an opacity, a blend's weight).
+WT_HD WT_INLINE float luminance(const vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
 // Procedural textures are functions of the object-space point (a sphere's: relative
 // to its centre); images are looked up by the surface's UVs (a sphere's from its normal).
 // Filtered = false: compiled for kernels without the mip-mapped lookup (the study's

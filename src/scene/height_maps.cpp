@@ -8,7 +8,7 @@ namespace wt {
 
 float channel_of(const float* texel, HeightChannel channel) {
   switch (channel) {
-    case HeightChannel::Luminance: return 0.2126f * texel[0] + 0.7152f * texel[1] + 0.0722f * texel[2];
+    case HeightChannel::Luminance: return luminance(vec3(texel[0], texel[1], texel[2]));
     case HeightChannel::Red: return texel[0];
     case HeightChannel::Green: return texel[1];
     case HeightChannel::Blue: return texel[2];

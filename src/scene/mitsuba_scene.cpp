@@ -14,6 +14,7 @@
 #include "errors/errors.hpp"
 #include "scene/bsdf_tables.hpp"
 #include "scene/input_file.hpp"
+#include "scene/mitsuba_metals.hpp"
 #include "wavetrace/bsdfs/microfacet.hpp"
 
 namespace wt::mitsuba {
@@ -81,6 +82,15 @@ const std::map<std::string, std::string>& named_metals() {
   static const std::map<std::string, std::string> metals = {
       {"Au", "gold"}, {"Ag", "silver"}, {"Cu", "copper"}, {"Al", "aluminium"}, {"Cr", "chromium"}, {"Ni_palik", "nickel"}};
   return metals;
+}
+
+// Mitsuba's other named conductors: the RGB eta and k its RGB variants load for
+// them (scene/mitsuba_metals.hpp, written by tools/mitsuba_metals.py), or null.
+const MitsubaMetal* mitsuba_metal(const std::string& name) {
+  for (const MitsubaMetal& metal : kMitsubaMetals) {
+    if (name == metal.name) return &metal;
+  }
+  return nullptr;
 }
 
 // A plugin's properties and nested objects as the mapping reads them: whatever is
@@ -596,6 +606,9 @@ class Converter {
       p.finish();
       s = bsdf(*inner);
       if (s.material.value("type", "") == "emissive") p.fail("an emitter's surface takes no " + type);
+      if (s.material.value("type", "") == "blend") {
+        p.fail("a " + type + " around a blendbsdf is not supported (give each of its BSDFs the map)");
+      }
       if (s.material.contains("normal_texture") || s.material.contains("bump_texture")) {
         p.fail("a normal or bump map on a surface that has one already is not supported");
       }
@@ -626,13 +639,17 @@ class Converter {
           m["f0"] = triple(1, 1, 1);  // Mitsuba's perfect mirror
         } else {
           const auto it = named_metals().find(metal);
-          if (it == named_metals().end()) {
+          if (it != named_metals().end()) {
+            m["metal"] = it->second;
+          } else if (const MitsubaMetal* named = mitsuba_metal(metal)) {
+            m["eta"] = triple(named->eta.x, named->eta.y, named->eta.z);
+            m["k"] = triple(named->k.x, named->k.y, named->k.z);
+          } else {
             std::string known;
             for (const auto& [k, v] : named_metals()) known += (known.empty() ? "" : ", ") + k;
-            p.fail("material '" + metal + "' is not one wavetrace holds measured data for (" + known +
-                   ", none): give eta and k");
+            p.fail("material '" + metal + "' is not one of Mitsuba's named conductors (" + known +
+                   ", the other names of its data/ior folder, none): give eta and k");
           }
-          m["metal"] = it->second;
         }
       }
       const bool tinted_mirror = m.contains("f0") && !p.nested("specular_reflectance") && p.has("specular_reflectance");
@@ -717,7 +734,26 @@ class Converter {
     } else if (type == "principled") {
       principled(p, m);
     } else if (type == "blendbsdf") {
-      p.fail("a blend of two BSDFs is not supported (wavetrace's materials mix only a metal into plastic and principled)");
+      // wavetrace's blend: the first BSDF at weight 0, the second at weight 1.
+      m["type"] = "blend";
+      if (const Object* t = p.child("texture", "weight")) {
+        m["weight"] = 1;
+        m["weight_texture"] = texture_name(*t, false, "weight");
+      } else {
+        const double w = p.number("weight", 0.5);
+        if (!(w >= 0 && w <= 1)) p.fail("weight must be in [0, 1]");
+        m["weight"] = w;
+      }
+      json names = json::array();
+      for (int i = 0; i < 2; ++i) {
+        const Object* inner = p.child("bsdf", "", true);
+        if (inner == nullptr) p.fail("needs two nested BSDFs");
+        const auto [name, alpha] = material(inner);
+        if (!alpha.is_null()) fail(*inner, "a mask within a blendbsdf is not supported (put the mask around the blend)");
+        names.push_back(name);
+      }
+      if (p.child("bsdf", "", true) != nullptr) p.fail("takes two nested BSDFs, not more");
+      m["materials"] = names;
     } else {
       p.fail("BSDF type '" + type + "' is not supported");
     }

@@ -1,10 +1,12 @@
 // Scene files: materials.
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "scene/bsdf_tables.hpp"
 #include "scene/conductor_presets.hpp"
 #include "scene/scene_reader.hpp"
+#include "wavetrace/blend.hpp"
 
 namespace wt {
 namespace {
@@ -23,8 +25,8 @@ std::string preset_names() {
 
 void SceneReader::read_material(const json& j, const JsonPath& path) {
   // In MaterialKind's order.
-  static const std::vector<std::string> kTypes = {"lambertian", "metal", "dielectric", "coated",
-                                                  "emissive",   "conductor", "glass", "plastic", "principled"};
+  static const std::vector<std::string> kTypes = {"lambertian", "metal", "dielectric", "coated",    "emissive",
+                                                  "conductor",  "glass", "plastic",    "principled", "blend"};
   static const std::vector<std::vector<std::string>> kKeys = {
       {"name", "type", "albedo", "texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
       {"name", "type", "albedo", "fuzz", "texture", "normal_texture", "normal_strength", "bump_texture", "bump_scale"},
@@ -43,6 +45,7 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
        "clearcoat_normal_texture", "clearcoat_normal_strength", "transmission", "transmission_texture", "thin",
        "attenuation_color", "attenuation_distance", "emission", "emission_texture", "specular_texture",
        "specular_color", "specular_color_texture"},
+      {"name", "type", "materials", "weight", "weight_texture"},
   };
   object(j, path);
   std::string n = name(j, path);
@@ -54,6 +57,12 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   m.kind = static_cast<MaterialKind>(type);
   m.texture = -1;
   m.ior = 1.0f;
+  if (m.kind == MaterialKind::Blend) {
+    read_blend(j, path, m);
+    scene_.materials.push_back(m);
+    scene_.material_names.push_back(n);
+    return;
+  }
   m.albedo = j.contains("albedo") ? colour(j["albedo"], path / "albedo") : vec3(1.0f);
   if (j.contains("fuzz")) m.fuzz = unit_interval(j["fuzz"], path / "fuzz");
   if (m.kind == MaterialKind::Dielectric || m.kind == MaterialKind::Coated) {
@@ -88,6 +97,48 @@ void SceneReader::read_material(const json& j, const JsonPath& path) {
   m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, texture_kind));
   scene_.materials.push_back(m);
   scene_.material_names.push_back(n);
+}
+
+// A blend of two materials named before it (so that blends cannot form a cycle),
+// neither of which emits (an emitter's light sampling needs every hit on it to
+// emit), at most kMaxBlendDepth blends deep.
+void SceneReader::read_blend(const json& j, const JsonPath& path, Material& m) {
+  const JsonPath at = path / "materials";
+  const json& list = required(j, path, "materials");
+  if (!list.is_array() || list.size() != 2) fail_at(at, "must be a list of two material names");
+  MaterialParams p{};
+  int depth = 1;
+  for (size_t i = 0; i < 2; ++i) {
+    const JsonPath item = at / i;
+    const std::string& name = string(list[i], item);
+    if (!material_names_.count(name)) {
+      fail_at(item, "unknown material '" + name + "' (a blend names materials defined before it)");
+    }
+    const int32_t index = material_named(list[i], item);
+    const Material& inner = scene_.materials[static_cast<size_t>(index)];
+    if (inner.kind == MaterialKind::Emissive || (inner.flags & kMaterialEmits)) {
+      fail_at(item, "material '" + name + "' emits: a blend's materials must not (give the blended surface its own emitter)");
+    }
+    if (inner.kind == MaterialKind::Blend) depth = std::max(depth, 1 + blend_depth(inner));
+    p.blend_materials[i] = index;
+  }
+  if (depth > kMaxBlendDepth) {
+    fail_at(at, "blends nest " + std::to_string(depth) + " deep; at most " + std::to_string(kMaxBlendDepth) + " are supported");
+  }
+  p.blend_weight = j.contains("weight") ? unit_interval(j["weight"], path / "weight") : 0.5f;
+  if (j.contains("weight_texture")) p.blend_texture = texture_named(j["weight_texture"], path / "weight_texture");
+  m.albedo = vec3(0.0f);
+  m.sort_key = static_cast<uint8_t>(material_sort_key(m.kind, -1));
+  m.params = static_cast<int32_t>(scene_.material_params.size());
+  scene_.material_params.push_back(p);
+}
+
+int SceneReader::blend_depth(const Material& m) const {
+  if (m.kind != MaterialKind::Blend) return 0;
+  const MaterialParams& p = scene_.material_params[static_cast<size_t>(m.params)];
+  int depth = 0;
+  for (int32_t index : p.blend_materials) depth = std::max(depth, blend_depth(scene_.materials[static_cast<size_t>(index)]));
+  return 1 + depth;
 }
 
 int32_t SceneReader::texture_named(const json& j, const JsonPath& path) const {

@@ -80,6 +80,9 @@ class SceneReader : JsonReader {
   // scene_materials.cpp
   void read_material(const json& j, const JsonPath& path);
   void read_params(const json& j, const JsonPath& path, Material& m);
+  void read_blend(const json& j, const JsonPath& path, Material& m);
+  // How many blends deep m is (0: not a blend).
+  int blend_depth(const Material& m) const;
   // A texture by name (the field's value); an error names the field.
   int32_t texture_named(const json& j, const JsonPath& path) const;
 

@@ -26,7 +26,7 @@ WT_HD WT_INLINE uint32_t intersect_one(uint32_t i, const Ray& ray, const Scene& 
     accumulate_one(film, pass_pixel(q.path[i], pass, rp.width, rp.height), t * sky_seen(scene, rp, ray.dir, q.pdf[i]));
     return pack_entry(kSortKeyMiss, i);
   }
-  return pack_entry(scene.material(material_index<Kinds>(scene, h)).sort_key, i);
+  return pack_entry(scene.material(shading_material_index<Kinds>(scene, ray, h)).sort_key, i);
 }
 
 // Slot i's ray as the queue holds it.

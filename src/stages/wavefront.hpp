@@ -47,8 +47,10 @@ constexpr Stage kSort{3, "sort"};
 constexpr Stage kShade{4, "shade"};
 constexpr Stage kShadow{5, "shadow"};
 constexpr std::array<Stage, 6> kAll = {kIntersect, kCompact, kReadback, kSort, kShade, kShadow};
-// Shade by material kind (RenderOptions::shade_by_kind), after the stages above.
-constexpr std::array<Stage, kMaterialKindCount> kShadeKinds = {
+// Shade by material kind (RenderOptions::shade_by_kind), after the stages above:
+// every kind but the blend, whose hits shade as the material they pick.
+static_assert(static_cast<uint32_t>(MaterialKind::Blend) + 1 == kMaterialKindCount, "the blend is the last kind");
+constexpr std::array<Stage, kMaterialKindCount - 1> kShadeKinds = {
     Stage{6, "  lambertian"}, Stage{7, "  metal"},     Stage{8, "  dielectric"}, Stage{9, "  coated"},
     Stage{10, "  emissive"},  Stage{11, "  conductor"}, Stage{12, "  glass"},     Stage{13, "  plastic"},
     Stage{14, "  principled"}};
