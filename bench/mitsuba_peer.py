@@ -48,7 +48,7 @@ EMITTED_PLUGINS = (
     "scene", "path", "perspective", "thinlens", "hdrfilm", "box", "independent",
     "sphere", "obj", "ply", "shapegroup", "instance",
     "diffuse", "twosided", "conductor", "roughconductor", "dielectric", "plastic",
-    "roughdielectric", "thindielectric", "roughplastic", "principled", "normalmap", "bumpmap",
+    "roughdielectric", "thindielectric", "roughplastic", "principled", "normalmap", "bumpmap", "blendbsdf",
     "area", "constant", "envmap", "bitmap", "rgb",
     "principledthin", "mask", "point", "spot", "directional", "volpath", "homogeneous", "constvolume",
 )

@@ -34,11 +34,12 @@ mkdir -p "$wheels" "$out_dir" "$build"
 # "scene" is part of libmitsuba. The glTF tiles add principledthin, mask, the
 # punctual lights (point, spot, directional), and volpath with a homogeneous
 # medium of a constvolume for absorbing volumes; bump maps add bumpmap; the shipped
-# Mitsuba scenes (scenes/mitsuba/) the built-in shapes, serialized and checkerboard.
+# Mitsuba scenes (scenes/mitsuba/) the built-in shapes, serialized, checkerboard and
+# blendbsdf (which wavetrace's blend converts to as well).
 PLUGINS="area isotropic bitmap box conductor constant d65 dielectric diffuse envmap hdrfilm independent instance merge
 bumpmap normalmap obj path perspective plastic ply principled regular roughconductor roughdielectric roughplastic shapegroup sphere
 srgb thindielectric thinlens twosided uniform principledthin mask point spot directional volpath homogeneous constvolume
-rectangle cube disk cylinder serialized checkerboard"
+rectangle cube disk cylinder serialized checkerboard blendbsdf"
 
 py_local=$(command -v python3)
 export PIP_ROOT_USER_ACTION=ignore PIP_DISABLE_PIP_VERSION_CHECK=1
@@ -76,11 +77,11 @@ done
 # Headers, CMake files, type stubs, tests, byte code; spectral data (srgb.coeff is the
 # spectral variants' RGB upsampling table), conductor IOR tables (the converter's
 # conductors are material 'none' or give eta and k as RGB values) and sun-sky tables;
-# but the tables of the metals that Mitsuba scenes may name by `material` and
-# wavetrace maps onto its presets (docs/scene-format.md, "Mitsuba 3 scenes").
+# but the conductors' tables, which Mitsuba scenes may name by `material` and
+# wavetrace maps every one of (docs/scene-format.md, "Mitsuba 3 scenes"; 0.6 MB).
 kept_ior=$build/kept-ior
 rm -rf "$kept_ior" && mkdir -p "$kept_ior"
-for metal in Au Ag Cu Al Cr Ni_palik; do cp "$mi"/data/ior/"$metal".*.spd "$kept_ior/"; done
+cp "$mi"/data/ior/*.spd "$kept_ior/"
 rm -rf "$mi/include" "$mi/cmake" "$mi/mitsuba_stubs" "$mi/python/test" "$mi/data" \
        "$dj/include" "$dj/cmake"
 mkdir -p "$mi/data/ior" && cp "$kept_ior"/*.spd "$mi/data/ior/"
