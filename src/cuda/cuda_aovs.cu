@@ -2,6 +2,7 @@
 // every sample of it in turn, as the CPU backend adds them.
 #include "cuda/cuda_aovs.hpp"
 #include "device/device.hpp"
+#include "device/kernel_bodies.hpp"
 #include "wavetrace/aov.hpp"
 
 namespace wt::cuda {
@@ -13,6 +14,7 @@ constexpr int kAovBlockY = 8;
 
 __global__ void __launch_bounds__(kAovBlockX * kAovBlockY)
     first_surface_kernel(SceneView scene, RenderParams rp, const int32_t* counts, float* sums) {
+#if WT_KERNEL_BODIES
   const int x = blockIdx.x * blockDim.x + threadIdx.x;
   const int y = blockIdx.y * blockDim.y + threadIdx.y;
   if (x >= rp.width || y >= rp.height) return;
@@ -22,6 +24,7 @@ __global__ void __launch_bounds__(kAovBlockX * kAovBlockY)
   for (int s = 0; s < samples; ++s) add_first_surface(local, first_surface(scene, rp, pixel, static_cast<uint32_t>(s)));
   float* out = sums + static_cast<size_t>(pixel) * kAovFloats;
   for (int i = 0; i < kAovFloats; ++i) out[i] = local[i];
+#endif
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "cuda/buffer.hpp"
 #include "cuda/event.hpp"
+#include "device/kernel_bodies.hpp"
 #include "stages/compact.hpp"
 #include "stages/sort.hpp"
 #include "stages/stage.hpp"
@@ -38,15 +39,19 @@ struct MinBlocksPerSm<Item, std::void_t<decltype(Item::kMinBlocksPerSm)>> {
 
 template <class Item>
 __global__ void for_each_kernel(Item item, uint32_t n) {
+#if WT_KERNEL_BODIES
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i < n) item(i);
+#endif
 }
 
 template <class Item>
 __global__ void __launch_bounds__(kBoundedBlock, MinBlocksPerSm<Item>::value)
     for_each_bounded_kernel(Item item, uint32_t n) {
+#if WT_KERNEL_BODIES
   const uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
   if (i < n) item(i);
+#endif
 }
 
 // The kernel that runs Item over a range.

@@ -5,6 +5,9 @@
 namespace wt::cuda {
 
 int device_count() {
+#if defined(WT_NO_DEVICE_CODE)
+  return 0;  // a host-only build (device/kernel_bodies.hpp): its kernels do nothing
+#endif
   int n = 0;
   if (cudaGetDeviceCount(&n) != cudaSuccess) {
     cudaGetLastError();  // clear the sticky "no device" error

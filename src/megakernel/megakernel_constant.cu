@@ -5,6 +5,7 @@
 #include <string>
 
 #include "device/device.hpp"
+#include "device/kernel_bodies.hpp"
 #include "errors/errors.hpp"
 #include "megakernel/megakernel.hpp"
 #include "megakernel/megakernel_body.cuh"
@@ -63,7 +64,9 @@ template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
     megakernel_constant(ConstantScene scene, RenderParams rp, int first_sample, int samples, MegakernelWork out,
                         unsigned long long* rays) {
+#if WT_KERNEL_BODIES
   megakernel_pixel<Kinds>(scene, rp, first_sample, samples, out, rays);
+#endif
 }
 
 }  // namespace

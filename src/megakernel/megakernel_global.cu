@@ -1,6 +1,7 @@
 #include <algorithm>
 
 #include "device/device.hpp"
+#include "device/kernel_bodies.hpp"
 #include "megakernel/megakernel.hpp"
 #include "megakernel/megakernel_body.cuh"
 
@@ -10,7 +11,9 @@ template <uint32_t Kinds>
 __global__ void __launch_bounds__(kMegakernelBlockX * kMegakernelBlockY)
     megakernel_global(SceneView scene, RenderParams rp, int first_sample, int samples, MegakernelWork out,
                       unsigned long long* rays) {
+#if WT_KERNEL_BODIES
   megakernel_pixel<Kinds>(scene, rp, first_sample, samples, out, rays);
+#endif
 }
 
 // Thread per pixel: the pixel's sums of the batch's earlier samples (`running`,
