@@ -3,6 +3,7 @@
 // that file), and through the command a mistake is bad input (exit code 2) with
 // no image written.
 #include <gtest/gtest.h>
+#include <stb/stb_image_write.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,6 +14,7 @@
 #include <fstream>
 
 #include "app/job.hpp"
+#include "dispatch/renderer.hpp"
 #include "errors/errors.hpp"
 #include "mesh_support.hpp"
 #include "scene/scene.hpp"
@@ -94,6 +96,54 @@ TEST_F(MeshScene, ObjWithAMissingMtlNamesTheFile) {
   const std::string scene = write_scene(R"([{"name": "a", "file": "mtl.obj"}])", R"([{"mesh": "a"}])");
   expect_error(scene, scene + ": /meshes/0/file: " + path("mtl.obj"),
                {"mtllib nowhere.mtl: " + path("nowhere.mtl") + ": cannot open material library"});
+}
+
+// A mesh given by its own arrays (what the Python module passes for numpy arrays)
+// is the mesh its OBJ file holds: the same triangles, normals and UVs (OBJ's v up),
+// so the renders are bit for bit the same.
+TEST_F(MeshScene, AMeshOfItsOwnArraysIsItsObj) {
+  std::ofstream(path("quad.obj")) << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                     "f 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n";
+  const std::string textures = R"("textures": [{"name": "t", "type": "image", "file": "t.png", "colorspace": "linear"}],)";
+  {
+    // A 2x2 image whose texels differ, so that a flipped v shows.
+    const unsigned char px[16] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255};
+    ASSERT_NE(stbi_write_png(path("t.png").c_str(), 2, 2, 4, px, 8), 0);
+  }
+  auto scene_with = [&](const std::string& mesh) {
+    const std::string p = path("arrays.json");
+    std::ofstream(p) << R"({"camera": {"look_from": [0, 0, 3], "look_at": [0, 0, 0]}, )" << textures
+                     << R"("materials": [{"name": "m", "type": "lambertian", "texture": "t"}],
+      "meshes": [)" << mesh << R"(], "instances": [{"mesh": "q"}]})";
+    return load_scene(p);
+  };
+  const Scene from_file = scene_with(R"({"name": "q", "file": "quad.obj", "material": "m"})");
+  const Scene from_arrays = scene_with(R"({"name": "q", "material": "m",
+      "positions": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], "indices": [[0, 1, 2], [0, 2, 3]],
+      "normals": [[0, 0, 1], [0, 0, 1], [0, 0, 1], [0, 0, 1]], "uvs": [[0, 0], [1, 0], [1, 1], [0, 1]]})");
+  RenderOptions o;
+  o.backend = Backend::Cpu;
+  o.params = RenderParams{16, 16, 2, 4, 4, 1};
+  EXPECT_EQ(render(from_file, o).rgb, render(from_arrays, o).rgb);
+  EXPECT_EQ(from_file.uvs.size(), from_arrays.uvs.size());
+}
+
+TEST_F(MeshScene, BadMeshArraysNameTheField) {
+  auto expect = [&](const std::string& mesh, std::initializer_list<std::string> parts) {
+    const std::string scene = write_scene("[" + mesh + "]", R"([{"mesh": "a"}])");
+    expect_error(scene, scene, parts);
+  };
+  const std::string tri = R"("positions": [[0, 0, 0], [1, 0, 0], [0, 1, 0]])";
+  expect({R"({"name": "a", )" + tri + "}"}, {"/meshes/0: a mesh given by \"positions\" needs \"indices\""});
+  expect({R"({"name": "a", )" + tri + R"(, "indices": [[0, 1, 3]]})"}, {"/meshes/0/indices/0/2"});
+  expect({R"({"name": "a", )" + tri + R"(, "indices": [[0, 1]]})"}, {"/meshes/0/indices/0: must be a row of 3 numbers"});
+  expect({R"({"name": "a", )" + tri + R"(, "indices": [[0, 1, 2]], "normals": [[0, 0, 1]]})"},
+         {"/meshes/0/normals: has 1 rows for 3 positions"});
+  expect({R"({"name": "a", "file": "tri.obj", )" + tri + R"(, "indices": [[0, 1, 2]]})"},
+         {"/meshes/0: give one of \"file\", \"shape\" or \"positions\""});
+  expect({R"({"name": "a", "file": "tri.obj", "uvs": [[0, 0]]})"}, {"/meshes/0/uvs: belongs to a mesh given by \"positions\""});
+  expect({R"({"name": "a", "positions": [[0, 0, 0], [1, 0, 0], [2, 0, 0]], "indices": [[0, 1, 2]]})"},
+         {"/meshes/0/positions: mesh 'a'"});
 }
 
 TEST_F(MeshScene, UnknownMeshInAnInstance) {

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "scene/input_file.hpp"
+#include "scene/mesh_formats.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/mesh_shapes.hpp"
 #include "errors/errors.hpp"
@@ -43,18 +44,26 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     int32_t material = -1;
     bool face_normals = false, flip_normals = false;
     std::optional<AlphaTest> alpha;
+    std::optional<IndexedMesh> data;  // the entry's own arrays ("positions", "indices", ...)
   };
   std::vector<Spec> specs;
   for (size_t i = 0; i < list.size(); ++i) {
     const JsonPath at = path / i;
     const json& j = list[i];
     object(j, at);
-    check_keys(j, at, {"name", "file", "shape", "shape_index", "material", "face_normals", "flip_normals", "alpha"});
+    check_keys(j, at, {"name", "file", "shape", "shape_index", "material", "face_normals", "flip_normals", "alpha",
+                       "positions", "indices", "normals", "uvs"});
     Spec s;
     s.name = name(j, at);
     remember(mesh_names_, s.name, i, "mesh", at);
-    if (j.contains("shape") == j.contains("file")) fail_at(at, "give either \"file\" or \"shape\"");
-    if (j.contains("shape")) {
+    const int sources = (j.contains("file") ? 1 : 0) + (j.contains("shape") ? 1 : 0) + (j.contains("positions") ? 1 : 0);
+    if (sources != 1) fail_at(at, "give one of \"file\", \"shape\" or \"positions\" (with \"indices\")");
+    for (const char* key : {"indices", "normals", "uvs"}) {
+      if (j.contains(key) && !j.contains("positions")) fail_at(at / key, "belongs to a mesh given by \"positions\"");
+    }
+    if (j.contains("positions")) {
+      s.data = read_mesh_arrays(j, at);
+    } else if (j.contains("shape")) {
       s.shape = string(j["shape"], at / "shape");
       if (std::find(shape_names().begin(), shape_names().end(), s.shape) == shape_names().end()) {
         fail_at(at / "shape", "unknown shape '" + s.shape + "' (expected " + listed(shape_names()) + ")");
@@ -78,7 +87,14 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
   const auto start = Clock::now();
   std::vector<std::future<TriangleMesh>> loading;
   for (const Spec& s : specs) {
-    if (!s.shape.empty()) {
+    if (s.data) {
+      loading.push_back(std::async(std::launch::deferred, [&s, this] {
+        TriangleMesh mesh;
+        mesh.source = "mesh '" + s.name + "'";
+        add_indexed_mesh(*s.data, mesh);
+        return mesh;
+      }));
+    } else if (!s.shape.empty()) {
       loading.push_back(std::async(std::launch::deferred, shape_mesh, s.shape));
     } else {
       loading.push_back(std::async(std::launch::async, [file = s.file, index = s.shape_index] { return load_mesh(file, index); }));
@@ -97,7 +113,9 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
       }
       if (specs[i].flip_normals) flip_normals(meshes.back());
     } catch (const InputError& e) {
-      if (first_error.empty()) first_error = source() + ": " + (path / i / "file").str() + ": " + e.what();
+      if (first_error.empty()) {
+        first_error = source() + ": " + (path / i / (specs[i].data ? "positions" : "file")).str() + ": " + e.what();
+      }
     }
   }
   if (!first_error.empty()) throw InputError(first_error);
@@ -106,9 +124,53 @@ void SceneReader::read_meshes(const json& list, const JsonPath& path) {
     try {
       add_mesh(meshes[i], specs[i].name, specs[i].material, specs[i].alpha ? &*specs[i].alpha : nullptr);
     } catch (const InputError& e) {  // a texture its materials name, its size
-      throw InputError(source() + ": " + (path / i / "file").str() + ": " + e.what());
+      throw InputError(source() + ": " + (path / i / (specs[i].data ? "positions" : "file")).str() + ": " + e.what());
     }
   }
+}
+
+// A mesh entry's own arrays: "positions" (rows of x, y, z), "indices" (rows of three
+// vertex indices, each below the vertex count), and "normals" (x, y, z) and "uvs"
+// (u, v; v = 0 the image's bottom row, as OBJ's) of every vertex where given.
+IndexedMesh SceneReader::read_mesh_arrays(const json& j, const JsonPath& path) const {
+  auto rows = [&](const char* key, size_t width, auto&& take) {
+    const JsonPath at = path / key;
+    const json& list = j[key];
+    if (!list.is_array()) fail_at(at, "must be a list of rows of " + std::to_string(width) + " numbers");
+    for (size_t r = 0; r < list.size(); ++r) {
+      const json& row = list[r];
+      if (!row.is_array() || row.size() != width) {
+        fail_at(at / r, "must be a row of " + std::to_string(width) + " numbers");
+      }
+      take(row, at / r);
+    }
+  };
+  IndexedMesh m;
+  rows("positions", 3, [&](const json& row, const JsonPath& at) { m.positions.push_back(position(row, at)); });
+  if (m.positions.empty()) fail_at(path / "positions", "holds no vertex");
+  if (!j.contains("indices")) fail_at(path, "a mesh given by \"positions\" needs \"indices\"");
+  const int64_t last = static_cast<int64_t>(m.positions.size()) - 1;
+  rows("indices", 3, [&](const json& row, const JsonPath& at) {
+    m.triangles.push_back({static_cast<uint32_t>(integer(row[0], at / 0, 0, last)),
+                           static_cast<uint32_t>(integer(row[1], at / 1, 0, last)),
+                           static_cast<uint32_t>(integer(row[2], at / 2, 0, last))});
+  });
+  if (j.contains("normals")) {
+    rows("normals", 3, [&](const json& row, const JsonPath& at) { m.normals.push_back(triple(row, at)); });
+  }
+  if (j.contains("uvs")) {
+    rows("uvs", 2, [&](const json& row, const JsonPath& at) {
+      const vec2 uv = pair(row, at);
+      m.uvs.push_back(vec2(uv.x, 1.0f - uv.y));
+    });
+  }
+  for (const auto& [key, count] : {std::pair<const char*, size_t>{"normals", m.normals.size()}, {"uvs", m.uvs.size()}}) {
+    if (j.contains(key) && count != m.positions.size()) {
+      fail_at(path / key, "has " + std::to_string(count) + " rows for " + std::to_string(m.positions.size()) +
+                              " positions (one a vertex)");
+    }
+  }
+  return m;
 }
 
 AlphaTest SceneReader::read_alpha(const json& j, const JsonPath& path) {

@@ -16,6 +16,7 @@
 #include "scene/bsdf_tables.hpp"
 #include "scene/height_maps.hpp"
 #include "scene/json_reader.hpp"
+#include "scene/mesh_formats.hpp"
 #include "scene/mesh_load.hpp"
 #include "scene/scene.hpp"
 
@@ -97,6 +98,8 @@ class SceneReader : JsonReader {
   // `alpha`: the mesh entry's own (with its material), or null.
   void add_mesh(const TriangleMesh& mesh, const std::string& name, int32_t material_override,
                 const AlphaTest* alpha = nullptr);
+  // A mesh entry's own arrays (positions, indices, normals, uvs).
+  IndexedMesh read_mesh_arrays(const json& j, const JsonPath& path) const;
   // A mesh entry's `alpha`: the test, its luminance image made where it reads that.
   AlphaTest read_alpha(const json& j, const JsonPath& path);
   void read_instance(const json& j, const JsonPath& path);
