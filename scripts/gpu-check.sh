@@ -25,31 +25,20 @@ if [[ -x "$bin/wavetrace-gltf-tiles" ]] && "$bin/wavetrace-gltf-tiles" "$out/til
   export WAVETRACE_TILES="$out/tiles"
 fi
 
-# Each test binary in GPU_CHECK_SHARDS processes at once (gtest's sharding; default:
-# the cores, at most 8), which share the GPU: its CPU tests take most of the time,
-# and a lent machine's time is short. A shard's log is BINARY.log.K.
-shards=${GPU_CHECK_SHARDS:-$(( $(nproc) < 8 ? $(nproc) : 8 ))}
 passed=0 failed=0 skipped=0 broken=()
 for t in "$bin"/*_tests; do
   [[ -x "$t" ]] || continue
   log="$out/$(basename "$t").log"
-  pids=()
-  for ((k = 0; k < shards; ++k)); do
-    # Test binaries that drive the command itself take its path; the others ignore it.
-    GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$k "$t" --gtest_brief=0 "$bin/wavetrace" >"$log.$k" 2>&1 &
-    pids+=($!)
-  done
-  rc=0
-  for pid in "${pids[@]}"; do wait "$pid" || rc=1; done
-  for ((k = 0; k < shards; ++k)); do
-    p=$(grep -oP '^\[  PASSED  \] \K[0-9]+' "$log.$k" | tail -1)
-    f=$(grep -oP '^\[  FAILED  \] \K[0-9]+(?= tests?, listed below)' "$log.$k" | tail -1)
-    s=$(grep -oP '^\[  SKIPPED \] \K[0-9]+(?= tests?,)' "$log.$k" | tail -1)
-    passed=$((passed + ${p:-0})) failed=$((failed + ${f:-0})) skipped=$((skipped + ${s:-0}))
-  done
+  # Test binaries that drive the command itself take its path; the others ignore it.
+  "$t" --gtest_brief=0 "$bin/wavetrace" >"$log" 2>&1
+  rc=$?
+  p=$(grep -oP '^\[  PASSED  \] \K[0-9]+' "$log" | tail -1)
+  f=$(grep -oP '^\[  FAILED  \] \K[0-9]+(?= tests?, listed below)' "$log" | tail -1)
+  s=$(grep -oP '^\[  SKIPPED \] \K[0-9]+(?= tests?,)' "$log" | tail -1)
+  passed=$((passed + ${p:-0})) failed=$((failed + ${f:-0})) skipped=$((skipped + ${s:-0}))
   if ((rc != 0)); then
     broken+=("$(basename "$t")")
-    cat "$log".* | grep -E '^\[  FAILED  \]' | sort -u
+    grep -E '^\[  FAILED  \]' "$log" | sort -u
   fi
 done
 
