@@ -9,7 +9,11 @@ build=${WAVETRACE_BUILD:-$root/build}
 bash "$root/scripts/setup.sh"
 source "$root/scripts/cuda-arch.sh"
 if [[ ! -f "$build/build.ninja" ]]; then
-  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" >/dev/null
+  # The Python module is built for Debian's Python, whose numpy and pytest setup.sh
+  # installs (WAVETRACE_PYTHON_EXE: another).
+  python_exe=${WAVETRACE_PYTHON_EXE:-/usr/bin/python3}
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" \
+    ${python_exe:+-DPython_EXECUTABLE="$python_exe"} >/dev/null
 fi
 cuda_arch_configure "$build"
 targets=()

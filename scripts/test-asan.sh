@@ -24,7 +24,7 @@ fi
 # to matter. Host-only (WAVETRACE_DEVICE_CODE=OFF, src/device/kernel_bodies.hpp): the
 # sanitizers check host code, and the kernels' device code took most of this build.
 cmake -S "$root" -B "$build" -DWAVETRACE_MUTANTS=ON -DCMAKE_CXX_FLAGS_RELEASE="-O1 -DNDEBUG" \
-  -DCMAKE_CUDA_FLAGS_RELEASE="-O1 -DNDEBUG" -DWAVETRACE_DEVICE_CODE=OFF >/dev/null
+  -DCMAKE_CUDA_FLAGS_RELEASE="-O1 -DNDEBUG" -DWAVETRACE_DEVICE_CODE=OFF -DWAVETRACE_PYTHON=OFF >/dev/null
 cuda_arch_configure "$build"
 cmake --build "$build" --parallel "$(nproc)"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1}

@@ -247,6 +247,8 @@ void check_outputs(const Job& job, bool distributed) {
 }
 
 // The render's options from the job and its scene.
+}  // namespace
+
 RenderOptions resolve_options(const Job& job, const Scene& scene) {
   RenderOptions options;
   options.params = resolve_params(scene, job);
@@ -272,6 +274,8 @@ RenderOptions resolve_options(const Job& job, const Scene& scene) {
   options.devices = parse_devices(job.devices, options.backend, cuda::device_count());
   return options;
 }
+
+namespace {
 
 // Of an MPI run: this rank's share of its host's devices or cores (and no checkpoint).
 void take_rank_share(const Job& job, const Cluster& cluster, RenderOptions& options) {

@@ -111,6 +111,10 @@ void print_outcome(const Job& job, const JobOutcome& o);
 // rank 0 alone writes, and every rank's outcome fails where any rank's part did.
 JobOutcome run_job(const Job& job, const Cluster& cluster);
 
+// The render options of a job on a scene: the job's settings over the scene's, its
+// kernel, backend and devices; throws InputError naming what is wrong.
+RenderOptions resolve_options(const Job& job, const Scene& scene);
+
 // Sets a setting of the table (already checked against its range).
 void set_setting(Job& job, SettingId id, int64_t value);
 // Adds "name=value" parameters of a Mitsuba scene to job.defines (a later one of a

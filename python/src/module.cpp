@@ -1,0 +1,222 @@
+// The Python module's native part, wavetrace._wavetrace (docs/python.md): the scene
+// readers, a render session (app/session.hpp) and the image writers, with the
+// command's settings table and messages. python/wavetrace/__init__.py wraps it.
+#include <nanobind/nanobind.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/function.h>
+#include <nanobind/stl/map.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/job.hpp"
+#include "app/session.hpp"
+#include "device/device.hpp"
+#include "errors/errors.hpp"
+#include "image/image_io.hpp"
+#include "render/settings.hpp"
+#include "scene/scene_file.hpp"
+
+namespace nb = nanobind;
+using nlohmann::json;
+
+namespace {
+
+// A Python value as JSON: dicts (string keys), lists and tuples, str, bool, int,
+// float, None, and numpy's arrays and scalars (through tolist() and item()).
+json to_json(nb::handle h) {
+  if (h.is_none()) return nullptr;
+  if (nb::isinstance<nb::bool_>(h)) return nb::cast<bool>(h);
+  if (nb::isinstance<nb::int_>(h)) return nb::cast<int64_t>(h);
+  if (nb::isinstance<nb::float_>(h)) return nb::cast<double>(h);
+  if (nb::isinstance<nb::str>(h)) return nb::cast<std::string>(h);
+  if (nb::isinstance<nb::dict>(h)) {
+    json out = json::object();
+    for (auto [key, value] : nb::borrow<nb::dict>(h)) {
+      if (!nb::isinstance<nb::str>(key)) {
+        throw wt::InputError("scene dict: a key must be a string (got " + nb::cast<std::string>(nb::repr(key)) + ")");
+      }
+      out[nb::cast<std::string>(key)] = to_json(value);
+    }
+    return out;
+  }
+  if (nb::isinstance<nb::list>(h) || nb::isinstance<nb::tuple>(h)) {
+    json out = json::array();
+    for (nb::handle item : h) out.push_back(to_json(item));
+    return out;
+  }
+  if (nb::hasattr(h, "tolist")) return to_json(h.attr("tolist")());  // a numpy array or scalar
+  throw wt::InputError("scene dict: " + nb::cast<std::string>(nb::repr(nb::type_name(h.type()))) +
+                       " is not a JSON value (dict, list, str, number, bool, None or a numpy array)");
+}
+
+// The keyword arguments of a render as a job: each setting of the settings table by
+// its key, and backend, kernel and devices, checked as the command checks them.
+wt::app::Job job_from(const nb::kwargs& kwargs) {
+  wt::app::Job job;
+  job.progress = false;
+  for (auto [k, v] : kwargs) {
+    const std::string key = nb::cast<std::string>(k);
+    if (key == "backend" || key == "kernel") {
+      if (!nb::isinstance<nb::str>(v)) throw wt::InputError(key + ": must be a string");
+      (key == "backend" ? job.backend : job.kernel) = nb::cast<std::string>(v);
+      continue;
+    }
+    if (key == "devices") {
+      if (nb::isinstance<nb::str>(v)) {
+        job.devices = nb::cast<std::string>(v);
+      } else {
+        std::string list;
+        for (nb::handle d : v) list += (list.empty() ? "" : ",") + std::to_string(nb::cast<int64_t>(d));
+        job.devices = list;
+      }
+      continue;
+    }
+    const wt::Setting* found = nullptr;
+    for (const wt::Setting& s : wt::settings()) {
+      if (key == s.key) found = &s;
+    }
+    if (found == nullptr) {
+      std::string known = "backend, kernel, devices";
+      for (const wt::Setting& s : wt::settings()) known += std::string(", ") + s.key;
+      throw wt::InputError("render: unknown setting '" + key + "' (known: " + known + ")");
+    }
+    if (found->type == wt::SettingType::Real) {
+      const double x = nb::cast<double>(v);
+      wt::check_real_setting(found->id, x);
+      job.noise_threshold = x;
+    } else {
+      if (nb::isinstance<nb::float_>(v) || nb::isinstance<nb::bool_>(v)) {
+        throw wt::InputError(key + ": must be an integer (got " + nb::cast<std::string>(nb::repr(v)) + ")");
+      }
+      const int64_t x = nb::cast<int64_t>(v);
+      wt::check_setting(found->id, x);
+      wt::app::set_setting(job, found->id, x);
+    }
+  }
+  return job;
+}
+
+// A scene loaded once, rendered as often as asked.
+struct PyScene {
+  std::shared_ptr<wt::app::Session> session;
+};
+
+PyScene make_scene(wt::Scene scene, const std::string& source) {
+  return PyScene{std::make_shared<wt::app::Session>(std::make_shared<const wt::Scene>(std::move(scene)), source)};
+}
+
+// An image of floats (H, W, C) owned by the array.
+nb::ndarray<nb::numpy, float> image_array(std::vector<float> values, size_t height, size_t width, size_t channels) {
+  auto* owned = new std::vector<float>(std::move(values));
+  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
+  return nb::ndarray<nb::numpy, float>(owned->data(), {height, width, channels}, owner);
+}
+
+// Renders with the GIL released; the progress callback and Ctrl-C are looked at
+// between passes with it held. A Python exception (KeyboardInterrupt, or one the
+// callback raised) stops the render there and is raised once it has returned.
+nb::tuple render(const PyScene& scene, const nb::object& progress, const nb::kwargs& kwargs) {
+  const wt::app::Job job = job_from(kwargs);
+  std::optional<nb::python_error> pending;
+  std::function<void(double)> on_progress;
+  if (!progress.is_none()) {
+    on_progress = [&](double done) {
+      nb::gil_scoped_acquire held;
+      if (pending) return;
+      try {
+        progress(done);
+      } catch (nb::python_error& e) {
+        pending.emplace(std::move(e));
+      }
+    };
+  }
+  const auto stop = [&]() {
+    nb::gil_scoped_acquire held;
+    if (!pending && PyErr_CheckSignals() != 0) pending.emplace();  // takes the raised KeyboardInterrupt
+    return pending.has_value();
+  };
+  wt::app::JobOutcome out;
+  {
+    nb::gil_scoped_release released;
+    out = scene.session->render(job, on_progress, stop);
+  }
+  if (pending) throw std::move(*pending);
+  const wt::RenderParams& p = out.params;
+  const size_t pixels = static_cast<size_t>(p.width) * p.height;
+  std::vector<float> rgba(pixels * 4);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[4 * i + c] = out.result.rgb[3 * i + c];
+    rgba[4 * i + 3] = 1.0f;
+  }
+  return nb::make_tuple(image_array(std::move(rgba), p.height, p.width, 4), scene.session->stats(job, out).dump());
+}
+
+void write_image(nb::ndarray<const float, nb::ndim<3>, nb::c_contig, nb::device::cpu> image, const std::string& path,
+                 const std::string& encoding) {
+  const size_t h = image.shape(0), w = image.shape(1), c = image.shape(2);
+  if (c != 3 && c != 4) throw wt::InputError("write_image: an image of 3 or 4 channels (got " + std::to_string(c) + ")");
+  if (encoding != "srgb" && encoding != "gamma2") throw wt::InputError("write_image: encoding must be srgb or gamma2");
+  wt::check_output_path(path);
+  std::vector<float> rgb(h * w * 3);
+  for (size_t i = 0; i < h * w; ++i) {
+    for (size_t k = 0; k < 3; ++k) rgb[3 * i + k] = image.data()[c * i + k];
+  }
+  nb::gil_scoped_release released;
+  wt::write_image(path, static_cast<int>(w), static_cast<int>(h), rgb,
+                  encoding == "srgb" ? wt::Encoding::Srgb : wt::Encoding::Gamma2);
+}
+
+}  // namespace
+
+NB_MODULE(_wavetrace, m) {
+  m.doc() = "wavetrace's native part: use the package wavetrace (docs/python.md)";
+  // Bad input (a scene, a setting, an output path) is a ValueError with the command's
+  // one line; a failure of the machine, a RuntimeError naming the call and the stage.
+  nb::register_exception_translator([](const std::exception_ptr& p, void*) {
+    try {
+      std::rethrow_exception(p);
+    } catch (const wt::InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const wt::OutputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const wt::DeviceError& e) {
+      PyErr_SetString(PyExc_RuntimeError, e.what());
+    }
+  });
+  nb::class_<PyScene>(m, "Scene", "A scene loaded once (load_scene, scene_from_dict), rendered as often as asked.")
+      .def_prop_ro("source", [](const PyScene& s) { return s.session->source(); }, "The file it was read from.")
+      .def_prop_ro(
+          "warnings", [](const PyScene& s) { return s.session->scene().warnings; },
+          "What the scene file holds that is not rendered as its author meant (a Mitsuba scene's mapping).");
+  m.def(
+      "load_scene",
+      [](const std::string& path, const std::map<std::string, std::string>& defines) {
+        return make_scene(wt::load_scene(path, defines), path);
+      },
+      nb::arg("path"), nb::arg("defines") = std::map<std::string, std::string>{},
+      "A scene file: wavetrace's JSON, or a Mitsuba 3 .xml with its parameters (defines).");
+  m.def(
+      "scene_from_dict",
+      [](const nb::dict& d, const std::string& source) {
+        return make_scene(wt::scene_from_document(to_json(d), source), source);
+      },
+      nb::arg("d"), nb::arg("source") = "scene.json",
+      "A scene in the JSON format's structure; relative paths are read from source's folder.");
+  m.def("render", &render, nb::arg("scene"), nb::arg("progress") = nb::none(), nb::arg("kwargs"),
+        "Renders the scene; returns (the (H, W, 4) float32 image, the stats as JSON text).");
+  m.def("kernels", [](const std::string& backend) { return wt::kernel_names(wt::app::parse_backend(backend)); },
+        nb::arg("backend") = "cpu", "The kernels a backend runs.");
+  m.def("cuda_device_count", [] { return wt::cuda::device_count(); }, "CUDA devices present.");
+  m.def("settings", [] {
+    std::vector<std::string> keys;
+    for (const wt::Setting& s : wt::settings()) keys.push_back(s.key);
+    return keys;
+  });
+  m.def("write_image", &write_image, nb::arg("image"), nb::arg("path"), nb::arg("encoding") = "srgb",
+        "Writes an (H, W, 3 or 4) float32 image: PNG (encoded), PFM or OpenEXR (linear), by extension.");
+}

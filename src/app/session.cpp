@@ -1,0 +1,55 @@
+#include "app/session.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <utility>
+
+#include "app/stats.hpp"
+#include "dispatch/renderer.hpp"
+
+namespace wt::app {
+
+Session::Session(std::shared_ptr<const Scene> scene, std::string source)
+    : scene_(std::move(scene)), source_(std::move(source)) {}
+
+JobOutcome Session::render(const Job& given, const std::function<void(double)>& progress,
+                           const std::function<bool()>& stop) const {
+  const auto start = std::chrono::steady_clock::now();
+  Job job = given;
+  job.scene = source_;
+  JobOutcome out;
+  RenderOptions options = resolve_options(job, *scene_);
+  out.params = options.params;
+  out.noise_threshold = options.noise_threshold > 0 ? options.noise_threshold : 0;
+  out.min_spp = options.min_spp;
+  out.backend = backend_name(options.backend);
+  out.kernel = kernel_name(options.kernel);
+  out.load_times = scene_->load_times;
+  out.geometry = scene_->summary();
+  out.scene_warnings = scene_->warnings;
+  if (progress) options.progress = [&progress](double done, uint64_t, double) { progress(done); };
+  AdaptiveHooks hooks;
+  if (stop) {
+    if (options.noise_threshold != 0) {
+      hooks.after_step = [&stop](const AdaptiveState&, bool) { return !stop(); };
+    } else {
+      // Passes of 1/256 of the samples, as a checkpointed `render` takes them: a stop
+      // is answered within one.
+      options.samples_per_pass = std::max(1, options.params.spp / 256);
+      options.after_pass = [&stop](int32_t, const FilmReader&) { return !stop(); };
+    }
+  }
+  out.result = wt::render(*scene_, options, hooks);
+  out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
+  out.job_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+nlohmann::json Session::stats(const Job& given, const JobOutcome& outcome) const {
+  Job job = given;
+  job.scene = source_;
+  job.output.clear();
+  return stats_json(job, outcome);
+}
+
+}  // namespace wt::app
