@@ -320,31 +320,14 @@ TEST(BlendRender, ABlendOfTwoLambertiansRendersAsTheirMixedAlbedo) {
 // to the same image (16 seeds each, within 4 standard errors, at most 3%).
 TEST(BlendRender, LightSamplingOnAndOffConvergeToTheSameImage) {
   const Scene scene = blend_scene();
-  auto means = [&](int nee) {
-    std::vector<double> out;
-    for (uint32_t seed = 1; seed <= 16; ++seed) {
-      RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 48, 8, 3, seed);
-      o.params.nee = nee;
-      out.push_back(mean(render(scene, o).rgb));
-    }
-    return out;
-  };
-  test::expect_same_expectation(means(1), means(0), 0.03);
+  test::expect_same_expectation(test::seed_means(scene, 32, 18, 48, 1), test::seed_means(scene, 32, 18, 48, 0), 0.03);
 }
 
 // The wavefront picks at intersect (for the sort key) what shade picks: the CPU's
 // wavefront kernels trace the megakernel's paths, only the film's additions ordered
 // otherwise.
 TEST(BlendRender, CpuWavefrontKernelsMatchTheMegakernelToRounding) {
-  const Scene scene = blend_scene();
-  const RenderResult mk = render(scene, options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 4, 8, 3, 1));
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
-    const RenderResult wf = render(scene, options_for(Backend::Cpu, k, 32, 18, 4, 8, 3, 1));
-    ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
-    for (size_t i = 0; i < mk.rgb.size(); ++i) {
-      ASSERT_NEAR(wf.rgb[i], mk.rgb[i], 1e-5f * (1.0f + std::fabs(mk.rgb[i]))) << kernel_name(k) << " " << i;
-    }
-  }
+  test::expect_cpu_wavefront_kernels_match_the_megakernel(blend_scene());
 }
 
 TEST(BlendRender, EveryCudaKernelAgreesWithTheCpu) {

@@ -277,14 +277,7 @@ TEST(MaterialRender, LightSamplingOnAndOffConvergeToTheSameImage) {
 // The CPU's wavefront kernels trace the same paths and light samples as its
 // megakernel; only the order of the film's additions differs.
 TEST(MaterialRender, CpuWavefrontKernelsMatchTheMegakernelToRounding) {
-  const RenderResult mk = render(materials_scene(), options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 4, 8, 3, 1));
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
-    const RenderResult wf = render(materials_scene(), options_for(Backend::Cpu, k, 32, 18, 4, 8, 3, 1));
-    ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
-    for (size_t i = 0; i < mk.rgb.size(); ++i) {
-      ASSERT_NEAR(wf.rgb[i], mk.rgb[i], 1e-5f * (1.0f + std::fabs(mk.rgb[i]))) << kernel_name(k) << " " << i;
-    }
-  }
+  test::expect_cpu_wavefront_kernels_match_the_megakernel(materials_scene());
 }
 
 // A flat quad (u along +x, the OBJ's v along -z: v = 0 at z = +1 is the image's
@@ -437,15 +430,7 @@ Scene bump_scene(const test::TestFolder& folder) {
 // The CPU's wavefront kernels shade bump maps as its megakernel does.
 TEST(MaterialRender, CpuWavefrontKernelsMatchTheMegakernelOnBumpMaps) {
   const test::TestFolder folder;
-  const Scene scene = bump_scene(folder);
-  const RenderResult mk = render(scene, options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 4, 8, 3, 1));
-  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
-    const RenderResult wf = render(scene, options_for(Backend::Cpu, k, 32, 18, 4, 8, 3, 1));
-    ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
-    for (size_t i = 0; i < mk.rgb.size(); ++i) {
-      ASSERT_NEAR(wf.rgb[i], mk.rgb[i], 1e-5f * (1.0f + std::fabs(mk.rgb[i]))) << kernel_name(k) << " " << i;
-    }
-  }
+  test::expect_cpu_wavefront_kernels_match_the_megakernel(bump_scene(folder));
 }
 
 // Light sampling on and off converge to the same image with bump maps: the bumped
@@ -454,16 +439,7 @@ TEST(MaterialRender, CpuWavefrontKernelsMatchTheMegakernelOnBumpMaps) {
 TEST(MaterialRender, LightSamplingOnAndOffConvergeOnBumpMaps) {
   const test::TestFolder folder;
   const Scene scene = bump_scene(folder);
-  auto means = [&](int nee) {
-    std::vector<double> out;
-    for (uint32_t seed = 1; seed <= 16; ++seed) {
-      RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 32, 8, 3, seed);
-      o.params.nee = nee;
-      out.push_back(mean(render(scene, o).rgb));
-    }
-    return out;
-  };
-  test::expect_same_expectation(means(1), means(0), 0.03);
+  test::expect_same_expectation(test::seed_means(scene, 32, 18, 32, 1), test::seed_means(scene, 32, 18, 32, 0), 0.03);
 }
 
 TEST(MaterialRender, EveryCudaKernelAgreesWithTheCpuOnBumpMaps) {

@@ -94,6 +94,33 @@ inline void expect_same_expectation(const std::vector<double>& a, const std::vec
                                     << " against " << mb << " +- " << sb;
 }
 
+// The image means of 16 seeds' CPU megakernel renders of `scene` (w x h at spp,
+// depth 8, roulette from 3), light sampling on or off (`nee`): one side of
+// expect_same_expectation's light sampling on/off comparisons.
+inline std::vector<double> seed_means(const Scene& scene, int w, int h, int spp, int nee) {
+  std::vector<double> out;
+  for (uint32_t seed = 1; seed <= 16; ++seed) {
+    RenderOptions o = options_for(Backend::Cpu, Kernel::Megakernel, w, h, spp, 8, 3, seed);
+    o.params.nee = nee;
+    out.push_back(mean(render(scene, o).rgb));
+  }
+  return out;
+}
+
+// The CPU's wavefront kernels trace the same paths and light samples as its
+// megakernel (32 x 18, 4 spp, seed 1); only the order of the film's additions
+// differs, so every value agrees to 1e-5 relative.
+inline void expect_cpu_wavefront_kernels_match_the_megakernel(const Scene& scene) {
+  const RenderResult mk = render(scene, options_for(Backend::Cpu, Kernel::Megakernel, 32, 18, 4, 8, 3, 1));
+  for (Kernel k : {Kernel::Wavefront, Kernel::WavefrontSorted, Kernel::WavefrontUnsorted}) {
+    const RenderResult wf = render(scene, options_for(Backend::Cpu, k, 32, 18, 4, 8, 3, 1));
+    ASSERT_EQ(wf.rgb.size(), mk.rgb.size());
+    for (size_t i = 0; i < mk.rgb.size(); ++i) {
+      ASSERT_NEAR(wf.rgb[i], mk.rgb[i], 1e-5f * (1.0f + std::fabs(mk.rgb[i]))) << kernel_name(k) << " " << i;
+    }
+  }
+}
+
 // Renders that lose no light return the sky's radiance 1 in every pixel: the mean
 // of 16 seeds' CPU renders (w x h at spp, no roulette before `depth`) within 4
 // standard errors of 1 (plus 1e-6, for the float sums of scenes whose every path
