@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "cuda/buffer.hpp"
 #include "cuda/cuda_aovs.hpp"
@@ -28,11 +31,11 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 // The megakernel renders in passes of samples (at least ten, so that progress can
 // be shown between them); the next pass is queued before the host waits on the
 // last one, unless after_pass must see each pass's film.
-RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const RenderOptions& options,
-                               int sm_count) {
+RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const SceneView& view,
+                               const RenderOptions& options, int sm_count) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
-  if (constant) upload_constant_scene(scene, ds.view(), ds.image_views());
+  if (constant) upload_constant_scene(scene, view, ds.image_views());
   // The pixels a sample visits: options.active_pixels, on the device, or every one.
   const size_t pixels = rendered_pixels(options);
   DeviceBuffer<uint32_t> active(options.active_pixels ? pixels : 0, kStage);
@@ -66,7 +69,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     if (constant) {
       launch_megakernel_constant(rp, first, count, out, rays.get(), nullptr);
     } else {
-      launch_megakernel(ds.view(), rp, first, count, out, rays.get(), nullptr);
+      launch_megakernel(view, rp, first, count, out, rays.get(), nullptr);
     }
   };
 
@@ -151,22 +154,134 @@ void require_device_memory(const RenderParams& rp, size_t need, size_t free_byte
 
 namespace {
 
-// The scene on the current device, checked to fit with the render's state, and
-// renders of any of the render's samples over it.
-class Uploaded {
+// The scene on one device, uploaded once: with the device as it was read before the
+// upload (its free memory, which the wave size is chosen from, so that a kept copy's
+// renders choose what a fresh upload's would) and the wavefront's setup (pinned
+// counters, the wave's memory), kept from one of its renders to the next.
+struct DeviceCopy {
+  DeviceCopy(const Scene& scene, const DeviceInfo& read_before) : info(read_before) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ds = std::make_unique<DeviceScene>(scene, scene.render.width, scene.render.height);
+    WT_CUDA(cudaDeviceSynchronize(), "scene upload");
+    upload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  DeviceInfo info;
+  std::unique_ptr<DeviceScene> ds;
+  double upload_seconds = 0;
+  WaveRenderer waves;
+};
+
+}  // namespace
+}  // namespace wt::cuda
+
+namespace wt {
+
+// Each device's copies of one scene, and whether a render holds each (two renders on
+// one device at once, a split that names it twice, take a copy each).
+struct ResidentScenes {
+  struct Slot {
+    std::shared_ptr<cuda::DeviceCopy> copy;
+    bool held = false;
+  };
+  const Scene* scene = nullptr;
+  std::mutex mutex;
+  std::map<int, std::vector<Slot>> by_device;
+  int64_t uploads = 0;
+};
+
+}  // namespace wt
+
+namespace wt::cuda {
+
+namespace {
+
+// The scene on the current device for one render, checked to fit with the render's
+// state (`state_bytes` of it, given the device as the copy read it): a free copy the
+// options' resident scenes keep there, or a new upload (kept there for the next
+// render where they are given). Given back when the render is done.
+class DeviceLease {
  public:
-  Uploaded(const Scene& scene, const RenderOptions& options) : scene_(scene), info_(device_info()) {
+  DeviceLease(const Scene& scene, const RenderOptions& options,
+              const std::function<size_t(const DeviceInfo&)>& state_bytes)
+      : resident_(options.resident) {
+    if (resident_ && resident_->scene != &scene) {
+      throw std::logic_error("cuda: resident copies of another scene");
+    }
     const RenderParams& rp = options.params;
-    wave_ = is_wavefront(options.kernel) ? choose_wave_size(options.wave_size, rp, info_.free_memory) : 0;
+    if (resident_) {
+      int device = 0;
+      WT_CUDA(cudaGetDevice(&device), "device selection");
+      std::lock_guard<std::mutex> lock(resident_->mutex);
+      std::vector<ResidentScenes::Slot>& slots = resident_->by_device[device];
+      for (size_t i = 0; i < slots.size() && !copy_; ++i) {
+        if (slots[i].held) continue;
+        // The scene is there: only the render's own state must fit beside it.
+        const DeviceInfo now = device_info();
+        require_device_memory(rp, state_bytes(slots[i].copy->info), now.free_memory, now.name);
+        slots[i].held = true;
+        copy_ = slots[i].copy;
+        device_ = device;
+        slot_ = i;
+      }
+      if (!copy_) {
+        copy_ = upload(scene, rp, state_bytes);
+        slots.push_back({copy_, true});
+        ++resident_->uploads;
+        device_ = device;
+        slot_ = slots.size() - 1;
+        uploaded_ = true;
+      }
+    } else {
+      copy_ = upload(scene, rp, state_bytes);
+      uploaded_ = true;
+    }
+  }
+  ~DeviceLease() {
+    if (!resident_) return;
+    std::lock_guard<std::mutex> lock(resident_->mutex);
+    resident_->by_device[device_][slot_].held = false;
+  }
+  DeviceLease(const DeviceLease&) = delete;
+  DeviceLease& operator=(const DeviceLease&) = delete;
+
+  DeviceCopy& copy() const { return *copy_; }
+  // The upload's time where this render made it; 0 where the copy was kept.
+  double upload_seconds() const { return uploaded_ ? copy_->upload_seconds : 0; }
+
+ private:
+  static std::shared_ptr<DeviceCopy> upload(const Scene& scene, const RenderParams& rp,
+                                            const std::function<size_t(const DeviceInfo&)>& state_bytes) {
+    const DeviceInfo info = device_info();
     // Checked before allocating anything: a render that cannot fit fails with a
     // message rather than with an allocation error halfway through.
-    require_device_memory(rp, render_state_bytes(rp, options.kernel, wave_) + scene.device_bytes(),
-                          info_.free_memory, info_.name);
-    const auto t0 = std::chrono::steady_clock::now();
-    ds_ = std::make_unique<DeviceScene>(scene, rp.width, rp.height);
-    WT_CUDA(cudaDeviceSynchronize(), "scene upload");
-    upload_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    require_device_memory(rp, state_bytes(info) + scene.device_bytes(), info.free_memory, info.name);
+    return std::make_shared<DeviceCopy>(scene, info);
   }
+
+  std::shared_ptr<ResidentScenes> resident_;
+  std::shared_ptr<DeviceCopy> copy_;
+  int device_ = 0;
+  size_t slot_ = 0;
+  bool uploaded_ = false;
+};
+
+// The wave size of a render on a device as the copy read it.
+int64_t wave_size_on(const RenderOptions& options, const DeviceInfo& info) {
+  return is_wavefront(options.kernel) ? choose_wave_size(options.wave_size, options.params, info.free_memory) : 0;
+}
+
+// The scene on the current device (DeviceLease), and renders of any of the render's
+// samples over it.
+class Uploaded {
+ public:
+  Uploaded(const Scene& scene, const RenderOptions& options)
+      : scene_(scene),
+        lease_(scene, options,
+               [&options](const DeviceInfo& info) {
+                 return render_state_bytes(options.params, options.kernel, wave_size_on(options, info));
+               }),
+        wave_(wave_size_on(options, lease_.copy().info)),
+        view_(lease_.copy().ds->view_at(scene, options.params.width, options.params.height)) {}
 
   // The sums the chunks of render_kept add to, cleared, and the host memory collect()
   // brings them back to: made before the render's clock starts (or at the first chunk).
@@ -197,25 +312,22 @@ class Uploaded {
   }
 
   RenderResult render(const RenderOptions& options) const {
+    DeviceCopy& copy = lease_.copy();
     RenderResult out = is_wavefront(options.kernel)
-                           ? waves_.render(ds_->view(), scene_.sort_key_bits(), options, wave_)
-                           : render_megakernel(scene_, *ds_, options, info_.sm_count);
-    out.upload_seconds = upload_;
-    out.device = info_.name;
+                           ? copy.waves.render(view_, scene_.sort_key_bits(), options, wave_)
+                           : render_megakernel(scene_, *copy.ds, view_, options, copy.info.sm_count);
+    out.upload_seconds = lease_.upload_seconds();
+    out.device = copy.info.name;
     return out;
   }
 
  private:
   const Scene& scene_;
-  DeviceInfo info_;
+  DeviceLease lease_;
   int64_t wave_ = 0;
-  std::unique_ptr<DeviceScene> ds_;
+  SceneView view_;
   std::unique_ptr<DeviceBuffer<float>> kept_;
   std::unique_ptr<PinnedBuffer<float>> kept_host_;
-  // The wavefront's setup (pinned counters, the wave's memory), kept from one of this
-  // device's renders to the next.
-  mutable WaveRenderer waves_;
-  double upload_ = 0;
 };
 
 }  // namespace
@@ -250,9 +362,8 @@ AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
   if (!options.devices.empty()) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
   const RenderParams& rp = options.params;
   const size_t floats = static_cast<size_t>(rp.width) * rp.height * kAovFloats;
-  const DeviceInfo info = device_info();
-  require_device_memory(rp, floats * sizeof(float) + scene.device_bytes(), info.free_memory, info.name);
-  const DeviceScene ds(scene, rp.width, rp.height);
+  const DeviceLease lease(scene, options, [floats](const DeviceInfo&) { return floats * sizeof(float); });
+  const SceneView view = lease.copy().ds->view_at(scene, rp.width, rp.height);
   DeviceBuffer<float> sums(floats, kAovStage);
   DeviceBuffer<int32_t> counts(pixel_samples ? pixel_samples->size() : 0, kAovStage);
   if (pixel_samples) counts.upload(*pixel_samples, kAovStage);
@@ -260,10 +371,40 @@ AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
   out.samples = rp.spp;
   EventTimer timer(kAovStage);
   timer.start();
-  launch_first_surface(ds.view(), rp, pixel_samples ? counts.get() : nullptr, sums.get(), nullptr);
+  launch_first_surface(view, rp, pixel_samples ? counts.get() : nullptr, sums.get(), nullptr);
   out.seconds = timer.stop();
   out.sums = sums.download(kAovStage);
   return out;
+}
+
+std::shared_ptr<ResidentScenes> keep_scene(const Scene& scene) {
+  auto out = std::make_shared<ResidentScenes>();
+  out->scene = &scene;
+  return out;
+}
+
+float* copy_to_device(const float* host, size_t n, int device) {
+  constexpr const char* kHandOff = "image hand-off";
+  WT_CUDA(cudaSetDevice(device), kHandOff);
+  void* p = nullptr;
+  WT_CUDA(cudaMalloc(&p, n * sizeof(float)), kHandOff);
+  const cudaError_t copied = cudaMemcpy(p, host, n * sizeof(float), cudaMemcpyHostToDevice);
+  if (copied != cudaSuccess) {
+    cudaFree(p);
+    check(static_cast<int>(copied), "cudaMemcpy(p, host, n * sizeof(float), cudaMemcpyHostToDevice)", kHandOff);
+  }
+  return static_cast<float*>(p);
+}
+
+void free_on_device(void* p) noexcept { cudaFree(p); }
+
+void copy_to_host(const float* on_device, size_t n, float* host) {
+  WT_CUDA(cudaMemcpy(host, on_device, n * sizeof(float), cudaMemcpyDeviceToHost), "image hand-off");
+}
+
+int64_t uploads(const ResidentScenes& resident) {
+  std::lock_guard<std::mutex> lock(const_cast<std::mutex&>(resident.mutex));
+  return resident.uploads;
 }
 
 }  // namespace wt::cuda

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <memory>
 
 #include "render/aovs.hpp"
 #include "render/device_renderer.hpp"
@@ -28,6 +30,21 @@ DeviceRenderer device_renderer(const Scene& scene, const RenderOptions& options,
 // the AOVs are made of.
 AovSums render_aov_sums(const Scene& scene, const RenderOptions& options,
                         const std::vector<int32_t>* pixel_samples = nullptr);
+
+// Copies of `scene` to keep on the devices from one render to the next, for
+// RenderOptions::resident; `scene` must outlive them. And how many uploads they have
+// made (each device's first render, and one more where two renders hold one device at
+// once).
+std::shared_ptr<ResidentScenes> keep_scene(const Scene& scene);
+int64_t uploads(const ResidentScenes& resident);
+
+// `n` floats copied into new memory on CUDA device `device` (an image handed to
+// another library where it lies: the Python module's DLPack arrays), which
+// free_on_device frees.
+float* copy_to_device(const float* host, size_t n, int device);
+void free_on_device(void* p) noexcept;
+// And back: `n` floats of device memory copied to `host`.
+void copy_to_host(const float* on_device, size_t n, float* host);
 
 // Device bytes a render with these settings needs beyond the scene itself.
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size);

@@ -60,6 +60,12 @@ DeviceScene::DeviceScene(const Scene& scene, int width, int height) {
   static_cast<SceneScalars&>(view_) = scene_scalars(scene, width, height, environment);
 }
 
+SceneView DeviceScene::view_at(const Scene& scene, int width, int height) const {
+  SceneView v = view_;
+  static_cast<SceneScalars&>(v) = scene_scalars(scene, width, height, view_.environment);
+  return v;
+}
+
 DeviceScene::~DeviceScene() {
   for (cudaTextureObject_t o : objects_) cudaDestroyTextureObject(o);
   for (cudaArray_t a : arrays_) cudaFreeArray(a);

@@ -17,6 +17,9 @@ class DeviceScene {
   DeviceScene& operator=(const DeviceScene&) = delete;
 
   const SceneView& view() const { return view_; }
+  // The view for a render of width x height of `scene` (the one uploaded): the same
+  // arrays, the camera made for that film.
+  SceneView view_at(const Scene& scene, int width, int height) const;
   // The host copies of the image views (texture objects filled in), for constant memory.
   const std::vector<ImageView>& image_views() const { return image_views_; }
 

@@ -149,6 +149,12 @@ AovSums render_aovs(const Scene& scene, const RenderOptions& options, const std:
   return out;
 }
 
+std::shared_ptr<ResidentScenes> keep_scene(const Scene& scene, Backend backend) {
+  return backend == Backend::Cuda ? cuda::keep_scene(scene) : nullptr;
+}
+
+int64_t scene_uploads(const ResidentScenes* resident) { return resident ? cuda::uploads(*resident) : 0; }
+
 void take_mean(RenderResult& r) {
   const float inv = 1.0f / static_cast<float>(r.samples);
   for (float& v : r.rgb) v *= inv;

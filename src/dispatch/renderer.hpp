@@ -41,6 +41,13 @@ RenderResult render_sums(const Scene& scene, const RenderOptions& options);
 AovSums render_aovs(const Scene& scene, const RenderOptions& options,
                     const std::vector<int32_t>* pixel_samples = nullptr);
 
+// Copies of `scene` kept on the devices between renders (RenderOptions::resident):
+// the backend's where it uploads a scene (CUDA), null where it renders the scene
+// where it lies (the CPU). `scene` must outlive them.
+std::shared_ptr<ResidentScenes> keep_scene(const Scene& scene, Backend backend);
+// The uploads those copies have made (0 for none).
+int64_t scene_uploads(const ResidentScenes* resident);
+
 // Turns a backend's pixel sums over r.samples samples into means (every render's
 // last step; also for a film that was complete when it was resumed).
 void take_mean(RenderResult& r);

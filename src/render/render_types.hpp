@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -84,6 +85,10 @@ class PathFeed {
 // no pass holds more paths than this, so any number of paths can be rendered.
 constexpr uint64_t kMaxPathsPerPass = 0xffffffffull;
 
+// A scene's copies kept on the devices from one render to the next (made by
+// dispatch/renderer.hpp's keep_scene; the CUDA backend's own).
+struct ResidentScenes;
+
 struct RenderOptions {
   RenderParams params{};
   Backend backend = Backend::Cpu;
@@ -137,6 +142,11 @@ struct RenderOptions {
   // the same rounds with no pixel stopping (for the variance they estimate). 0: off.
   double noise_threshold = 0;
   int32_t min_spp = 0;
+  // The scene's copies kept on the devices (a session's, app/session.hpp): a render
+  // uploads the scene only to a device that holds no free copy of it, and leaves its
+  // copy there for the next. Null: each render uploads its own and frees it. The
+  // image is the same either way.
+  std::shared_ptr<ResidentScenes> resident;
 };
 
 // The pixels a render's samples visit: those listed, or every one.
