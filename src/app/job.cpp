@@ -468,6 +468,51 @@ void render_rank(const Job& job, const Scene& scene, RenderOptions& options, con
   out.result = render_sums(scene, options);
 }
 
+}  // namespace
+
+void render_first_surface(const Job& job, const Scene& scene, const RenderOptions& options, JobOutcome& out) {
+  bool first_surface = job.denoise;
+  for (AovKind k : job_aovs(job)) first_surface = first_surface || from_first_surface(k);
+  // An adaptive render's pass takes each pixel's own samples.
+  if (first_surface) {
+    out.aovs = render_aovs(scene, options, out.result.pixel_samples.empty() ? nullptr : &out.result.pixel_samples);
+  }
+}
+
+std::vector<float> denoise_outcome(const Job& job, const RenderOptions& options, JobOutcome& out) {
+  const int w = options.params.width, h = options.params.height;
+  std::vector<float> denoised;
+  // Guided by the albedo and the normal of the first-surface pass.
+  const std::vector<float> albedo = denoise_albedo(out.aovs);
+  const std::vector<float> normal = denoise_normal(out.aovs);
+  const auto start = std::chrono::steady_clock::now();
+  DenoiseDevice device = options.backend == Backend::Cuda ? DenoiseDevice::Cuda : DenoiseDevice::Cpu;
+  const DenoiseQuality quality = job.denoise_quality == "balanced" ? DenoiseQuality::Balanced : DenoiseQuality::High;
+  try {
+    denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
+  } catch (const DeviceError& e) {
+    if (device == DenoiseDevice::Cpu) throw;
+    // OIDN without its CUDA device here (a driver it does not take, a module not
+    // installed): the CPU's, said on stderr.
+    std::fprintf(stderr, "wavetrace: %s; denoising on the CPU\n", e.what());
+    device = DenoiseDevice::Cpu;
+    denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
+  }
+  out.denoise_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out.denoise_device = device == DenoiseDevice::Cuda ? "cuda" : "cpu";
+  return denoised;
+}
+
+std::vector<AovImage> job_aov_images(const Job& job, const JobOutcome& out) {
+  std::vector<AovImage> aovs;
+  for (AovKind k : job_aovs(job)) {
+    aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs) : result_aov_image(k, out.result));
+  }
+  return aovs;
+}
+
+namespace {
+
 // Says so where pixels are not finite (the stats count them too).
 void warn_nonfinite(const Job& job, JobOutcome& out) {
   out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
@@ -485,35 +530,12 @@ void write_job(const Job& job, const RenderOptions& options, JobOutcome& out,
   // up during the second leaves neither.
   const int w = options.params.width, h = options.params.height;
   const ExrPixels exr = job.exr_float ? ExrPixels::Float : ExrPixels::Half;
-  // A denoised job's output is the denoiser's image (on the CUDA device where the
-  // render ran on one), the render itself its noisy image where kept.
-  std::vector<float> denoised;
-  if (job.denoise) {
-    // Guided by the albedo and the normal of the first-surface pass.
-    const std::vector<float> albedo = denoise_albedo(out.aovs);
-    const std::vector<float> normal = denoise_normal(out.aovs);
-    const auto start = std::chrono::steady_clock::now();
-    DenoiseDevice device = options.backend == Backend::Cuda ? DenoiseDevice::Cuda : DenoiseDevice::Cpu;
-    const DenoiseQuality quality = job.denoise_quality == "balanced" ? DenoiseQuality::Balanced : DenoiseQuality::High;
-    try {
-      denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
-    } catch (const DeviceError& e) {
-      if (device == DenoiseDevice::Cpu) throw;
-      // OIDN without its CUDA device here (a driver it does not take, a module not
-      // installed): the CPU's, said on stderr.
-      std::fprintf(stderr, "wavetrace: %s; denoising on the CPU\n", e.what());
-      device = DenoiseDevice::Cpu;
-      denoised = denoise({w, h, out.result.rgb.data(), albedo.data(), normal.data()}, quality, device);
-    }
-    out.denoise_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    out.denoise_device = device == DenoiseDevice::Cuda ? "cuda" : "cpu";
-  }
+  // A denoised job's output is the denoiser's image, the render itself its noisy
+  // image where kept.
+  const std::vector<float> denoised = job.denoise ? denoise_outcome(job, options, out) : std::vector<float>{};
   const auto write_start = std::chrono::steady_clock::now();
   // The AOVs: layers of an OpenEXR output, else files of their own beside it.
-  std::vector<AovImage> aovs;
-  for (AovKind k : job_aovs(job)) {
-    aovs.push_back(from_first_surface(k) ? aov_image(k, out.aovs) : result_aov_image(k, out.result));
-  }
+  const std::vector<AovImage> aovs = job_aov_images(job, out);
   const std::vector<JobFile> aov_files = aov_outputs(job);
   std::vector<ImageLayer> layers;
   if (aov_files.empty()) {
@@ -582,14 +604,7 @@ JobOutcome run_job(const Job& job, const Cluster& cluster) {
   if (out.exit_code != 0 || !cluster.root()) return out;
   guarded(out, [&] {
     if (distributed && out.result.radiance == Radiance::SumOfSamples) take_mean(out.result);
-    // The AOVs and the denoiser's guides: one first-surface pass over the whole
-    // render's samples, whatever kernel, checkpoint or ranks made the image.
-    bool first_surface = job.denoise;
-    for (AovKind k : job_aovs(job)) first_surface = first_surface || from_first_surface(k);
-    // An adaptive render's pass takes each pixel's own samples.
-    if (first_surface) {
-      out.aovs = render_aovs(*scene, options, out.result.pixel_samples.empty() ? nullptr : &out.result.pixel_samples);
-    }
+    render_first_surface(job, *scene, options, out);
     write_job(job, options, out, job_start);
   });
   return out;

@@ -115,6 +115,18 @@ JobOutcome run_job(const Job& job, const Cluster& cluster);
 // kernel, backend and devices; throws InputError naming what is wrong.
 RenderOptions resolve_options(const Job& job, const Scene& scene);
 
+// The phases after a job's render, for run_job and a session (app/session.hpp):
+// - the first-surface pass (render_aovs) where the job's AOVs or its denoiser need
+//   it, over the render's samples (an adaptive render's each pixel's own), into
+//   out.aovs;
+// - the denoiser's image of out.result (guided by out.aovs' albedo and normal; on
+//   the CUDA device where the render ran on one, else or where OIDN has none there on
+//   the CPU, said on stderr), its seconds and device in `out`;
+// - the AOVs the job names, as images, in its order.
+void render_first_surface(const Job& job, const Scene& scene, const RenderOptions& options, JobOutcome& out);
+std::vector<float> denoise_outcome(const Job& job, const RenderOptions& options, JobOutcome& out);
+std::vector<AovImage> job_aov_images(const Job& job, const JobOutcome& out);
+
 // Sets a setting of the table (already checked against its range).
 void set_setting(Job& job, SettingId id, int64_t value);
 // Adds "name=value" parameters of a Mitsuba scene to job.defines (a later one of a

@@ -5,20 +5,34 @@
 #include <utility>
 
 #include "app/stats.hpp"
+#include "app/job_files.hpp"
 #include "dispatch/renderer.hpp"
+#include "image/denoise.hpp"
 
 namespace wt::app {
 
 Session::Session(std::shared_ptr<const Scene> scene, std::string source)
     : scene_(std::move(scene)), source_(std::move(source)) {}
 
-JobOutcome Session::render(const Job& given, const std::function<void(double)>& progress,
-                           const std::function<bool()>& stop) const {
+SessionRender Session::render(const Job& given, const std::function<void(double)>& progress,
+                              const std::function<bool()>& stop) const {
   const auto start = std::chrono::steady_clock::now();
   Job job = given;
   job.scene = source_;
-  JobOutcome out;
+  SessionRender done;
+  JobOutcome& out = done.outcome;
   RenderOptions options = resolve_options(job, *scene_);
+  job_aovs(job);  // the list checked before the render
+  if (job.denoise) {
+    std::string why;
+    if (!oidn_available(why)) throw InputError("denoise: " + why);
+  }
+  if (options.backend == Backend::Cuda) {
+    std::lock_guard<std::mutex> lock(resident_mutex_);
+    if (!resident_) resident_ = keep_scene(*scene_, options.backend);
+    options.resident = resident_;
+    done.cuda_device = options.devices.empty() ? 0 : options.devices.front();
+  }
   out.params = options.params;
   out.noise_threshold = options.noise_threshold > 0 ? options.noise_threshold : 0;
   out.min_spp = options.min_spp;
@@ -41,8 +55,25 @@ JobOutcome Session::render(const Job& given, const std::function<void(double)>& 
   }
   out.result = wt::render(*scene_, options, hooks);
   out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
+  if (!out.result.interrupted) {
+    options.progress = nullptr;
+    render_first_surface(job, *scene_, options, out);
+    if (job.denoise) done.denoised = denoise_outcome(job, options, out);
+    done.aovs = job_aov_images(job, out);
+  }
   out.job_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
+  return done;
+}
+
+int64_t Session::uploads() const {
+  std::lock_guard<std::mutex> lock(resident_mutex_);
+  return released_uploads_ + scene_uploads(resident_.get());
+}
+
+void Session::release_devices() {
+  std::lock_guard<std::mutex> lock(resident_mutex_);
+  released_uploads_ += scene_uploads(resident_.get());
+  resident_.reset();
 }
 
 nlohmann::json Session::stats(const Job& given, const JobOutcome& outcome) const {

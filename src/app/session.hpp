@@ -4,9 +4,12 @@
 // written, and the stats are `--stats`'s.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -14,31 +17,49 @@
 
 namespace wt::app {
 
+// A session's render: the outcome (its result holding each pixel's mean radiance),
+// and what the job asked for beside it.
+struct SessionRender {
+  JobOutcome outcome;
+  std::vector<float> denoised;  // the denoiser's image (width x height x 3) where the job denoises
+  std::vector<AovImage> aovs;   // the job's AOVs (its `aov` list), in its order
+  int cuda_device = 0;          // the CUDA device it ran on (the first of several); 0 on the CPU
+};
+
 class Session {
  public:
   // `scene` as loaded from `source`, the name the messages and the stats give it.
   Session(std::shared_ptr<const Scene> scene, std::string source);
 
-  // Renders the scene with the job's settings (its scene, output, stats, checkpoint,
-  // denoise and AOV fields are not read). `progress`: the share done, called from the
+  // Renders the scene with the job's settings, its AOVs and its denoiser (its scene,
+  // output, stats, checkpoint and keep_noisy fields are not read). On the CUDA backend
+  // the scene is uploaded to a device at its first render there and kept for the
+  // next (uploads() counts them); renders may run from several threads at once. `progress`: the share done, called from the
   // rendering thread; `stop`: asked after every pass (a uniform render then takes
   // passes of 1/256 of its samples, as a checkpointed `render` does; an adaptive one
   // asks after each step), true ends the render there (the outcome's result then says
-  // interrupted). Throws InputError for bad settings and
+  // interrupted, and no AOV or denoiser runs). Throws InputError for bad settings and
   // DeviceError when the machine fails, as run_job reports them. The result holds
   // each pixel's mean radiance.
-  JobOutcome render(const Job& job, const std::function<void(double)>& progress = {},
-                    const std::function<bool()>& stop = {}) const;
+  SessionRender render(const Job& job, const std::function<void(double)>& progress = {},
+                       const std::function<bool()>& stop = {}) const;
 
   // What `--stats` writes for that render.
   nlohmann::json stats(const Job& job, const JobOutcome& outcome) const;
 
   const Scene& scene() const { return *scene_; }
   const std::string& source() const { return source_; }
+  // The scene's uploads to devices so far.
+  int64_t uploads() const;
+  // Frees the scene's copies on the devices (the next render uploads it again).
+  void release_devices();
 
  private:
   std::shared_ptr<const Scene> scene_;
   std::string source_;
+  mutable std::mutex resident_mutex_;
+  mutable std::shared_ptr<ResidentScenes> resident_;  // made at the first CUDA render
+  mutable int64_t released_uploads_ = 0;              // of copies released since
 };
 
 }  // namespace wt::app
