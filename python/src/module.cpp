@@ -5,6 +5,7 @@
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/function.h>
 #include <nanobind/stl/map.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
@@ -15,6 +16,7 @@
 
 #include "app/job.hpp"
 #include "app/session.hpp"
+#include "cuda/cuda_backend.hpp"
 #include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "image/image_io.hpp"
@@ -66,6 +68,26 @@ wt::app::Job job_from(const nb::kwargs& kwargs) {
       (key == "backend" ? job.backend : job.kernel) = nb::cast<std::string>(v);
       continue;
     }
+    if (key == "aovs") {
+      if (nb::isinstance<nb::str>(v)) {
+        job.aov = nb::cast<std::string>(v);
+      } else {
+        for (nb::handle a : v) job.aov += (job.aov.empty() ? "" : ",") + nb::cast<std::string>(a);
+      }
+      wt::parse_aovs(job.aov, "aovs");  // the names checked with this field's name
+      continue;
+    }
+    if (key == "denoise") {
+      if (!nb::isinstance<nb::bool_>(v)) throw wt::InputError("denoise: must be True or False");
+      job.denoise = nb::cast<bool>(v);
+      continue;
+    }
+    if (key == "denoise_quality") {
+      const std::string q = nb::isinstance<nb::str>(v) ? nb::cast<std::string>(v) : "";
+      if (q != "high" && q != "balanced") throw wt::InputError("denoise_quality: must be 'high' or 'balanced'");
+      job.denoise_quality = q;
+      continue;
+    }
     if (key == "devices") {
       if (nb::isinstance<nb::str>(v)) {
         job.devices = nb::cast<std::string>(v);
@@ -81,7 +103,7 @@ wt::app::Job job_from(const nb::kwargs& kwargs) {
       if (key == s.key) found = &s;
     }
     if (found == nullptr) {
-      std::string known = "backend, kernel, devices";
+      std::string known = "backend, kernel, devices, aovs, denoise, denoise_quality";
       for (const wt::Setting& s : wt::settings()) known += std::string(", ") + s.key;
       throw wt::InputError("render: unknown setting '" + key + "' (known: " + known + ")");
     }
@@ -110,18 +132,41 @@ PyScene make_scene(wt::Scene scene, const std::string& source) {
   return PyScene{std::make_shared<wt::app::Session>(std::make_shared<const wt::Scene>(std::move(scene)), source)};
 }
 
-// An image of floats (H, W, C) owned by the array.
-nb::ndarray<nb::numpy, float> image_array(std::vector<float> values, size_t height, size_t width, size_t channels) {
-  auto* owned = new std::vector<float>(std::move(values));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
-  return nb::ndarray<nb::numpy, float>(owned->data(), {height, width, channels}, owner);
+// An image of floats (H, W, C) owned by the array: in host memory, a numpy array;
+// in CUDA device `cuda_device`'s memory (>= 0), an array that hands itself over by
+// DLPack (torch.from_dlpack, cupy.from_dlpack read it where it lies).
+nb::object image_array(std::vector<float> values, size_t height, size_t width, size_t channels, int cuda_device) {
+  if (cuda_device < 0) {
+    auto* owned = new std::vector<float>(std::move(values));
+    nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
+    return nb::cast(nb::ndarray<nb::numpy, float>(owned->data(), {height, width, channels}, owner));
+  }
+  float* on_device = wt::cuda::copy_to_device(values.data(), values.size(), cuda_device);
+  nb::capsule owner(on_device, [](void* p) noexcept { wt::cuda::free_on_device(p); });
+  return nb::cast(nb::ndarray<float, nb::device::cuda>(on_device, {height, width, channels}, owner, {},
+                                                       nb::dtype<float>(), nb::device::cuda::value, cuda_device));
+}
+
+// Pixels of 3 floats as (H, W, 4): alpha 1.
+std::vector<float> rgba_of(const std::vector<float>& rgb) {
+  const size_t pixels = rgb.size() / 3;
+  std::vector<float> rgba(pixels * 4);
+  for (size_t i = 0; i < pixels; ++i) {
+    for (int c = 0; c < 3; ++c) rgba[4 * i + c] = rgb[3 * i + c];
+    rgba[4 * i + 3] = 1.0f;
+  }
+  return rgba;
 }
 
 // Renders with the GIL released; the progress callback and Ctrl-C are looked at
 // between passes with it held. A Python exception (KeyboardInterrupt, or one the
 // callback raised) stops the render there and is raised once it has returned.
-nb::tuple render(const PyScene& scene, const nb::object& progress, const nb::kwargs& kwargs) {
+nb::tuple render(const PyScene& scene, const nb::object& progress, const std::string& device, const nb::kwargs& kwargs) {
+  if (device != "cpu" && device != "cuda") throw wt::InputError("device: must be 'cpu' or 'cuda' (got '" + device + "')");
   const wt::app::Job job = job_from(kwargs);
+  if (device == "cuda" && wt::cuda::device_count() == 0) {
+    throw wt::DeviceError("device: cuda was asked for the image, but no CUDA device is present");
+  }
   std::optional<nb::python_error> pending;
   std::function<void(double)> on_progress;
   if (!progress.is_none()) {
@@ -140,20 +185,31 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const nb::kwa
     if (!pending && PyErr_CheckSignals() != 0) pending.emplace();  // takes the raised KeyboardInterrupt
     return pending.has_value();
   };
-  wt::app::JobOutcome out;
+  wt::app::SessionRender done;
   {
     nb::gil_scoped_release released;
-    out = scene.session->render(job, on_progress, stop);
+    done = scene.session->render(job, on_progress, stop);
   }
   if (pending) throw std::move(*pending);
+  const wt::app::JobOutcome& out = done.outcome;
   const wt::RenderParams& p = out.params;
-  const size_t pixels = static_cast<size_t>(p.width) * p.height;
-  std::vector<float> rgba(pixels * 4);
-  for (size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 3; ++c) rgba[4 * i + c] = out.result.rgb[3 * i + c];
-    rgba[4 * i + 3] = 1.0f;
+  const size_t h = p.height, w = p.width;
+  const int on = device == "cuda" ? done.cuda_device : -1;
+  nb::dict aovs;
+  for (wt::AovImage& a : done.aovs) {
+    const size_t c = a.channels.size();
+    aovs[a.name.c_str()] = image_array(std::move(a.values), h, w, c, on);
   }
-  return nb::make_tuple(image_array(std::move(rgba), p.height, p.width, 4), scene.session->stats(job, out).dump());
+  // A denoised render's image is the denoiser's; the render itself its noisy image.
+  nb::object noisy = nb::none();
+  nb::object image;
+  if (job.denoise) {
+    image = image_array(rgba_of(done.denoised), h, w, 4, on);
+    noisy = image_array(rgba_of(out.result.rgb), h, w, 4, on);
+  } else {
+    image = image_array(rgba_of(out.result.rgb), h, w, 4, on);
+  }
+  return nb::make_tuple(image, scene.session->stats(job, out).dump(), aovs, noisy);
 }
 
 void write_image(nb::ndarray<const float, nb::ndim<3>, nb::c_contig, nb::device::cpu> image, const std::string& path,
@@ -191,6 +247,13 @@ NB_MODULE(_wavetrace, m) {
   nb::class_<PyScene>(m, "Scene", "A scene loaded once (load_scene, scene_from_dict), rendered as often as asked.")
       .def_prop_ro("source", [](const PyScene& s) { return s.session->source(); }, "The file it was read from.")
       .def_prop_ro(
+          "uploads", [](const PyScene& s) { return s.session->uploads(); },
+          "How many times the scene was uploaded to a device: once a device, at its first render there "
+          "(and once more for each render that shares a device with another at the same time).")
+      .def(
+          "release_devices", [](const PyScene& s) { s.session->release_devices(); },
+          "Frees the scene's copies on the devices; the next render there uploads it again.")
+      .def_prop_ro(
           "warnings", [](const PyScene& s) { return s.session->scene().warnings; },
           "What the scene file holds that is not rendered as its author meant (a Mitsuba scene's mapping).");
   m.def(
@@ -207,11 +270,27 @@ NB_MODULE(_wavetrace, m) {
       },
       nb::arg("d"), nb::arg("source") = "scene.json",
       "A scene in the JSON format's structure; relative paths are read from source's folder.");
-  m.def("render", &render, nb::arg("scene"), nb::arg("progress") = nb::none(), nb::arg("kwargs"),
-        "Renders the scene; returns (the (H, W, 4) float32 image, the stats as JSON text).");
+  m.def("render", &render, nb::arg("scene"), nb::arg("progress") = nb::none(), nb::arg("device") = "cpu",
+        nb::arg("kwargs"),
+        "Renders the scene; returns (the (H, W, 4) float32 image, the stats as JSON text, the AOVs by name, "
+        "the noisy image of a denoised render or None), the arrays in host memory (device 'cpu') or on the "
+        "render's CUDA device ('cuda').");
   m.def("kernels", [](const std::string& backend) { return wt::kernel_names(wt::app::parse_backend(backend)); },
         nb::arg("backend") = "cpu", "The kernels a backend runs.");
   m.def("cuda_device_count", [] { return wt::cuda::device_count(); }, "CUDA devices present.");
+  m.def(
+      "to_host",
+      [](nb::ndarray<const float, nb::device::cuda, nb::c_contig> a) {
+        std::vector<float> values(a.size());
+        wt::cuda::copy_to_host(a.data(), a.size(), values.data());
+        std::vector<size_t> shape;
+        for (size_t i = 0; i < a.ndim(); ++i) shape.push_back(a.shape(i));
+        auto* owned = new std::vector<float>(std::move(values));
+        nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
+        return nb::ndarray<nb::numpy, float>(owned->data(), shape.size(), shape.data(), owner);
+      },
+      nb::arg("array"), "A float32 array in CUDA device memory, copied to a numpy array.");
+  m.def("aov_names", [] { return wt::aov_names(); }, "The AOVs render(aovs=...) returns.");
   m.def("settings", [] {
     std::vector<std::string> keys;
     for (const wt::Setting& s : wt::settings()) keys.push_back(s.key);

@@ -7,7 +7,11 @@ command beside it) where the module was built.
 - bad input raises ValueError with the command's one-line message, a missing device
   RuntimeError;
 - Ctrl-C during a render raises KeyboardInterrupt within a second and leaves the
-  scene usable; the progress callback sees the render through to 1.
+  scene usable; the progress callback sees the render through to 1;
+- the AOVs are the command's --aov files, a denoised render's image the command's;
+- on CUDA (skipped without a device): the image is the command's, the scene is
+  uploaded once for renders of any settings (counted), and device="cuda" hands the
+  image to torch through DLPack without a copy (skipped without torch).
 """
 
 import json
@@ -28,12 +32,18 @@ BIN = Path(os.environ.get("WAVETRACE_BIN", ROOT / "build" / "wavetrace"))
 CORNELL = ROOT / "scenes" / "cornell-box.json"
 
 
+HAS_CUDA = any(d["backend"] == "cuda" for d in wt.devices())
+needs_cuda = pytest.mark.skipif(not HAS_CUDA, reason="no CUDA device")
+
+
 def read_pfm(path):
     with open(path, "rb") as f:
-        assert f.readline().strip() == b"PF"
+        kind = f.readline().strip()
+        assert kind in (b"PF", b"Pf")
         w, h = map(int, f.readline().split())
         scale = float(f.readline())
-        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4").reshape(h, w, 3)
+        c = 3 if kind == b"PF" else 1
+        data = np.frombuffer(f.read(), dtype="<f4" if scale < 0 else ">f4").reshape(h, w, c)
     return data[::-1]  # PFM's rows run bottom to top
 
 
@@ -41,15 +51,23 @@ def small(**kw):
     return dict(dict(width=48, height=32, spp=4, seed=3, backend="cpu"), **kw)
 
 
-@pytest.mark.parametrize("kernel", ["megakernel", "wavefront"])
-def test_the_module_renders_what_the_command_renders(tmp_path, kernel):
+def command(tmp_path, *args, name="cli.pfm"):
+    """The command's render of the Cornell box at small()'s settings (the backend and
+    the rest in args), read back."""
     if not BIN.exists():
         pytest.skip("no wavetrace command at %s" % BIN)
-    out = tmp_path / "cli.pfm"
-    subprocess.run([str(BIN), "render", str(CORNELL), "-o", str(out), "--backend", "cpu", "--kernel", kernel,
-                    "--width", "48", "--height", "32", "--spp", "4", "--seed", "3", "-q"], check=True)
-    cli = read_pfm(out)
-    img = wt.render(wt.load_scene(str(CORNELL)), kernel=kernel, **small())
+    out = tmp_path / name
+    subprocess.run([str(BIN), "render", str(CORNELL), "-o", str(out), "--width", "48", "--height", "32",
+                    "--spp", "4", "--seed", "3", "-q", *args], check=True)
+    return read_pfm(out)
+
+
+@pytest.mark.parametrize("backend,kernel", [("cpu", "megakernel"), ("cpu", "wavefront"),
+                                            pytest.param("cuda", "megakernel", marks=needs_cuda),
+                                            pytest.param("cuda", "wavefront", marks=needs_cuda)])
+def test_the_module_renders_what_the_command_renders(tmp_path, backend, kernel):
+    cli = command(tmp_path, "--backend", backend, "--kernel", kernel)
+    img = wt.render(wt.load_scene(str(CORNELL)), kernel=kernel, **small(backend=backend))
     assert img.shape == (32, 48, 4) and img.dtype == np.float32
     assert np.all(img[..., 3] == 1)
     if kernel == "megakernel":
@@ -58,7 +76,84 @@ def test_the_module_renders_what_the_command_renders(tmp_path, kernel):
         # The wavefront's threads add to the film in their own order: to its rounding.
         np.testing.assert_allclose(img[..., :3], cli, rtol=1e-5, atol=1e-6)
     assert img.stats["kernel"] == kernel and img.stats["settings"]["spp"] == 4
-    assert img.stats["backend"] == "cpu" and img.stats["paths"] == 48 * 32 * 4
+    assert img.stats["backend"] == backend and img.stats["paths"] == 48 * 32 * 4
+
+
+def test_the_aovs_are_the_commands(tmp_path):
+    command(tmp_path, "--backend", "cpu", "--aov", "albedo,normal,depth", name="a.pfm")
+    img = wt.render(wt.load_scene(str(CORNELL)), aovs=["albedo", "normal", "depth"], **small())
+    assert list(img.aovs) == ["albedo", "normal", "depth"]
+    for name in img.aovs:
+        np.testing.assert_array_equal(img.aovs[name], read_pfm(tmp_path / ("a.%s.pfm" % name)))
+    assert img.aovs["depth"].shape == (32, 48, 1) and img.aovs["albedo"].shape == (32, 48, 3)
+    assert img.aovs["albedo"].max() > 0 and np.isfinite(img.aovs["depth"]).any()
+    with pytest.raises(ValueError, match=r"^aovs: .*'shine'"):
+        wt.render(wt.load_scene(str(CORNELL)), aovs="albedo,shine", **small())
+
+
+def test_a_denoised_render_is_the_commands(tmp_path):
+    scene = wt.load_scene(str(CORNELL))
+    try:
+        img = wt.render(scene, denoise=True, **small(width=64, height=64))
+    except ValueError as e:
+        if str(e).startswith("denoise: "):
+            pytest.skip("Open Image Denoise is not here: %s" % e)
+        raise
+    if not BIN.exists():
+        pytest.skip("no wavetrace command at %s" % BIN)
+    out = tmp_path / "d.pfm"
+    subprocess.run([str(BIN), "render", str(CORNELL), "-o", str(out), "--width", "64", "--height", "64",
+                    "--spp", "4", "--seed", "3", "-q", "--backend", "cpu", "--denoise", "--keep-noisy"], check=True)
+    np.testing.assert_allclose(img[..., :3], read_pfm(out), rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(img.noisy[..., :3], read_pfm(tmp_path / "d.noisy.pfm"))
+    assert img.stats["denoise"]["device"] == "cpu"
+
+
+@needs_cuda
+def test_a_scene_is_uploaded_once_for_renders_of_any_settings():
+    scene = wt.load_scene(str(CORNELL))
+    assert scene.uploads == 0
+    first = wt.render(scene, kernel="megakernel", **small(backend="cuda"))
+    assert scene.uploads == 1
+    # Other kernels, sizes, samples and the AOVs' pass: the same copy.
+    for kernel in wt.kernels("cuda"):
+        wt.render(scene, kernel=kernel, aovs=["albedo"], **small(backend="cuda", width=40, height=24))
+    again = wt.render(scene, kernel="megakernel", **small(backend="cuda"))
+    assert scene.uploads == 1
+    assert again.stats["upload_seconds"] == 0 and first.stats["upload_seconds"] > 0
+    # The kept copy renders what a fresh one renders, bit for bit.
+    np.testing.assert_array_equal(again, first)
+    np.testing.assert_array_equal(wt.render(wt.load_scene(str(CORNELL)), kernel="megakernel",
+                                            **small(backend="cuda")), again)
+    scene.release_devices()
+    wt.render(scene, kernel="megakernel", **small(backend="cuda"))
+    assert scene.uploads == 2
+
+
+@needs_cuda
+def test_a_cuda_image_is_handed_over_by_dlpack():
+    scene = wt.load_scene(str(CORNELL))
+    on_gpu = wt.render(scene, device="cuda", aovs=["normal"], **small(backend="cuda", kernel="megakernel"))
+    assert on_gpu.__dlpack_device__()[0] == 2 and on_gpu.shape == (32, 48, 4)  # kDLCUDA
+    host = wt.render(scene, **small(backend="cuda", kernel="megakernel"))
+    np.testing.assert_array_equal(on_gpu.numpy(), host)
+    torch = pytest.importorskip("torch")
+    t = torch.from_dlpack(on_gpu)
+    assert t.is_cuda and tuple(t.shape) == (32, 48, 4) and t.dtype == torch.float32
+    assert torch.from_dlpack(on_gpu).data_ptr() == t.data_ptr()  # the same memory: no copy
+    np.testing.assert_array_equal(t.cpu().numpy(), host)
+    np.testing.assert_array_equal(torch.from_dlpack(on_gpu.aovs["normal"]).cpu().numpy(),
+                                  wt.render(scene, aovs=["normal"], **small(backend="cuda",
+                                                                            kernel="megakernel")).aovs["normal"])
+
+
+def test_a_cuda_image_needs_a_device():
+    if HAS_CUDA:
+        pytest.skip("a CUDA device is present")
+    with pytest.raises(RuntimeError, match="^device: cuda was asked for the image, but no CUDA device is present"):
+        wt.render(wt.load_scene(str(CORNELL)), device="cuda", **small())
+    with pytest.raises(ValueError, match="^device: must be 'cpu' or 'cuda'"):
+        wt.render(wt.load_scene(str(CORNELL)), device="gpu", **small())
 
 
 def test_a_dict_scene_renders_as_its_json_file():
@@ -161,3 +256,11 @@ def test_the_lists_name_what_the_command_takes():
     assert "wavefront" in wt.kernels("cpu") and "megakernel-constant" not in wt.kernels("cpu")
     assert {"spp", "width", "height", "seed", "noise_threshold"} <= set(wt.settings())
     assert wt.devices()[0] == {"backend": "cpu", "index": 0}
+
+
+def test_the_package_carries_its_type_stubs():
+    here = Path(wt.__file__).parent
+    assert (here / "py.typed").exists()
+    stub = (here / "_wavetrace.pyi").read_text()
+    for name in ("def render(", "def load_scene(", "class Scene", "def uploads(", "def release_devices("):
+        assert name in stub, name
