@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""What a render through the Python module costs beyond the render itself, against
+the command line doing the same work (issue 27: no more than 1% on a 1080p render,
+the scene loaded once).
+
+For each kernel, the same render (scene, size, samples, seed, backend):
+- the command, `runs` times: its stats' `seconds` (the render alone: CUDA events on
+  the GPU, wall clock on the CPU) and `job_seconds` (the whole job: load, upload,
+  render, write), and the process's wall clock;
+- the module, the scene loaded once and rendered once first (its upload), then
+  `runs` timed calls of wavetrace.render: each call's wall clock in Python, and its
+  stats' `seconds`.
+
+The overhead is the module's call against the command's render: median call wall
+clock over median command `seconds`, less 1; and, within each call, its wall clock
+less its own render `seconds` (what the module adds: bringing the film back, the
+mean, the RGBA array, the stats).
+
+    PYTHONPATH=build/python python3 bench/python_overhead.py --bin build/wavetrace \\
+        --backend cuda --out overhead.json
+"""
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import wavetrace as wt
+
+
+def command_runs(args, kernel, tmp):
+    out = []
+    for i in range(args.runs):
+        stats = Path(tmp) / ("cli-%s-%d.json" % (kernel, i))
+        cmd = [args.bin, "render", args.scene, "-o", str(Path(tmp) / "cli.exr"), "--width", str(args.width),
+               "--height", str(args.height), "--spp", str(args.spp), "--seed", "1", "--backend", args.backend,
+               "--kernel", kernel, "--stats", str(stats), "-q"]
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True)
+        wall = time.perf_counter() - t0
+        s = json.loads(stats.read_text())
+        out.append({"seconds": s["seconds"], "job_seconds": s["job_seconds"], "process_seconds": wall})
+    return out
+
+
+def module_runs(args, kernel, scene):
+    settings = dict(width=args.width, height=args.height, spp=args.spp, seed=1, backend=args.backend, kernel=kernel)
+    wt.render(scene, **settings)  # the upload (CUDA), and the first render's set-up
+    out = []
+    for _ in range(args.runs):
+        t0 = time.perf_counter()
+        img = wt.render(scene, **settings)
+        wall = time.perf_counter() - t0
+        out.append({"call_seconds": wall, "seconds": img.stats["seconds"],
+                    "upload_seconds": img.stats["upload_seconds"]})
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--bin", required=True, help="the wavetrace command")
+    ap.add_argument("--scene", default="scenes/cornell-box.json")
+    ap.add_argument("--backend", default="cuda")
+    ap.add_argument("--kernels", nargs="+", default=None, help="default: every kernel of the backend")
+    ap.add_argument("--width", type=int, default=1920)
+    ap.add_argument("--height", type=int, default=1080)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--out", default=None, help="a JSON file of every run and the medians")
+    args = ap.parse_args()
+    kernels = args.kernels or wt.kernels(args.backend)
+    scene = wt.load_scene(args.scene)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for kernel in kernels:
+            cli = command_runs(args, kernel, tmp)
+            mod = module_runs(args, kernel, scene)
+            cli_render = statistics.median(r["seconds"] for r in cli)
+            call = statistics.median(r["call_seconds"] for r in mod)
+            added = statistics.median(r["call_seconds"] - r["seconds"] for r in mod)
+            rows.append({"kernel": kernel, "command": cli, "module": mod,
+                         "command_render_seconds": cli_render,
+                         "command_job_seconds": statistics.median(r["job_seconds"] for r in cli),
+                         "command_process_seconds": statistics.median(r["process_seconds"] for r in cli),
+                         "module_call_seconds": call,
+                         "module_render_seconds": statistics.median(r["seconds"] for r in mod),
+                         "module_added_seconds": added,
+                         "overhead_vs_command": call / cli_render - 1,
+                         "added_share": added / call})
+    report = {"scene": args.scene, "backend": args.backend, "width": args.width, "height": args.height,
+              "spp": args.spp, "runs": args.runs, "uploads": scene.uploads, "rows": rows}
+    print("| kernel | command render s | command job s | module call s | module render s | added by the module | "
+          "call vs command render |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        print("| %s | %.4f | %.3f | %.4f | %.4f | %.1f ms (%.2f%%) | %+.2f%% |" % (
+            r["kernel"], r["command_render_seconds"], r["command_job_seconds"], r["module_call_seconds"],
+            r["module_render_seconds"], 1e3 * r["module_added_seconds"], 100 * r["added_share"],
+            100 * r["overhead_vs_command"]))
+    print("scene uploads through the module: %d" % scene.uploads)
+    if args.out:
+        Path(args.out).write_text(json.dumps(report, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
