@@ -340,6 +340,47 @@ TEST(Split, OneGpuTwiceRendersTheOneGpuImage) {
   }
 }
 
+// A scene's copies kept on the device between renders (a session's): the first render
+// uploads, every later one (another kernel, film size, an adaptive render, the AOVs'
+// pass) takes that copy and renders what a fresh upload renders, bit for bit where the
+// kernel is; a split that names the device twice holds two copies at once.
+TEST(ResidentScenes, OneUploadServesRendersOfAnySettings) {
+  WT_REQUIRE_CUDA();
+  const std::shared_ptr<ResidentScenes> kept = keep_scene(quick(), Backend::Cuda);
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(scene_uploads(kept.get()), 0);
+  EXPECT_EQ(keep_scene(quick(), Backend::Cpu), nullptr);  // the CPU renders the scene where it lies
+  for (int round = 0; round < 2; ++round) {
+    for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
+      for (int width : {64, 40}) {
+        RenderOptions o = quick_options(Backend::Cuda, k, {0});
+        o.params.width = width;
+        const RenderResult fresh = render(quick(), o);
+        o.resident = kept;
+        const RenderResult again = render(quick(), o);
+        expect_same_image(fresh, again, !is_wavefront(k), kernel_name(k));
+        EXPECT_EQ(again.upload_seconds > 0, round == 0 && k == Kernel::Megakernel && width == 64);
+      }
+    }
+  }
+  RenderOptions adaptive = quick_options(Backend::Cuda, Kernel::Wavefront, {0});
+  adaptive.noise_threshold = 0.05;
+  RenderResult a = render(quick(), adaptive);
+  adaptive.resident = kept;
+  RenderResult b = render(quick(), adaptive);
+  expect_same_image(a, b, false, "adaptive");
+  const AovSums aovs = render_aovs(quick(), adaptive);
+  adaptive.resident = nullptr;
+  EXPECT_EQ(aovs.sums, render_aovs(quick(), adaptive).sums);
+  EXPECT_EQ(scene_uploads(kept.get()), 1);
+  RenderOptions twice = quick_options(Backend::Cuda, Kernel::Megakernel, {0, 0});
+  twice.resident = kept;
+  render(quick(), twice);
+  EXPECT_EQ(scene_uploads(kept.get()), 2);  // the second worker's copy, kept too
+  render(quick(), twice);
+  EXPECT_EQ(scene_uploads(kept.get()), 2);
+}
+
 // Two GPUs where the machine has them: the split over both is the one-GPU image,
 // and (chunks) both take part.
 TEST(Split, TwoGpusRenderTheOneGpuImage) {
