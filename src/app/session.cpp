@@ -6,6 +6,7 @@
 
 #include "app/stats.hpp"
 #include "app/job_files.hpp"
+#include "device/device.hpp"
 #include "dispatch/renderer.hpp"
 #include "image/denoise.hpp"
 
@@ -53,7 +54,14 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
       options.after_pass = [&stop](int32_t, const FilmReader&) { return !stop(); };
     }
   }
-  out.result = wt::render(*scene_, options, hooks);
+  try {
+    out.result = wt::render(*scene_, options, hooks);
+  } catch (const DeviceError&) {
+    // As run_job does: an error that left the context usable is cleared, so that the
+    // next render (and the kept copies, still valid) can run.
+    cuda::recover_after_error();
+    throw;
+  }
   out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
   if (!out.result.interrupted) {
     options.progress = nullptr;
