@@ -16,6 +16,7 @@
 
 #include "app/job.hpp"
 #include "app/session.hpp"
+#include "cpu/parallel.hpp"
 #include "cuda/cuda_backend.hpp"
 #include "device/device.hpp"
 #include "errors/errors.hpp"
@@ -132,34 +133,50 @@ PyScene make_scene(wt::Scene scene, const std::string& source) {
   return PyScene{std::make_shared<wt::app::Session>(std::make_shared<const wt::Scene>(std::move(scene)), source)};
 }
 
-// An image of floats (H, W, C) owned by the array: in host memory, a numpy array;
-// in CUDA device `cuda_device`'s memory (>= 0), an array that hands itself over by
-// DLPack (torch.from_dlpack, cupy.from_dlpack read it where it lies).
-nb::object image_array(std::vector<float> values, size_t height, size_t width, size_t channels, int cuda_device) {
+// An image of floats (H, W, C) at `data`, kept alive by `owner`: in host memory, a
+// numpy array; in CUDA device `cuda_device`'s memory (>= 0), copied there into an
+// array that hands itself over by DLPack (torch.from_dlpack, cupy.from_dlpack read
+// it where it lies).
+nb::object image_array(const float* data, const nb::capsule& owner, size_t height, size_t width, size_t channels,
+                       int cuda_device) {
   if (cuda_device < 0) {
-    auto* owned = new std::vector<float>(std::move(values));
-    nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
-    return nb::cast(nb::ndarray<nb::numpy, float>(owned->data(), {height, width, channels}, owner));
+    return nb::cast(nb::ndarray<nb::numpy, float>(const_cast<float*>(data), {height, width, channels}, owner));
   }
-  float* on_device = wt::cuda::copy_to_device(values.data(), values.size(), cuda_device);
-  nb::capsule owner(on_device, [](void* p) noexcept { wt::cuda::free_on_device(p); });
-  return nb::cast(nb::ndarray<float, nb::device::cuda>(on_device, {height, width, channels}, owner, {},
-                                                       nb::dtype<float>(), nb::device::cuda::value, cuda_device));
+  const size_t n = height * width * channels;
+  float* on_device = wt::cuda::copy_to_device(data, n, cuda_device);
+  nb::capsule device_owner(on_device, [](void* p) noexcept { wt::cuda::free_on_device(p); });
+  return nb::cast(nb::ndarray<nb::array_api, float, nb::device::cuda>(
+      on_device, {height, width, channels}, device_owner, {}, nb::dtype<float>(), nb::device::cuda::value,
+      cuda_device));
 }
 
-// Pixels of 3 floats as (H, W, 4): alpha 1.
-std::vector<float> rgba_of(const std::vector<float>& rgb) {
-  const size_t pixels = rgb.size() / 3;
-  std::vector<float> rgba(pixels * 4);
-  for (size_t i = 0; i < pixels; ++i) {
-    for (int c = 0; c < 3; ++c) rgba[4 * i + c] = rgb[3 * i + c];
-    rgba[4 * i + 3] = 1.0f;
-  }
-  return rgba;
+nb::object image_array(std::vector<float> values, size_t height, size_t width, size_t channels, int cuda_device) {
+  auto* owned = new std::vector<float>(std::move(values));
+  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
+  return image_array(owned->data(), owner, height, width, channels, cuda_device);
+}
+
+// Pixels of 3 floats as an (H, W, 4) image, alpha 1, written over the host's
+// threads into memory nothing clears first (a 1080p image is 8 M floats, a share of
+// a short render).
+nb::object rgba_array(const std::vector<float>& rgb, size_t height, size_t width, int cuda_device) {
+  const int64_t pixels = static_cast<int64_t>(rgb.size() / 3);
+  float* out = new float[static_cast<size_t>(pixels) * 4];
+  nb::capsule owner(out, [](void* p) noexcept { delete[] static_cast<float*>(p); });
+  const float* in = rgb.data();
+  wt::cpu::parallel_for(pixels, int64_t(1) << 16, wt::cpu::thread_count(0), [in, out](int64_t begin, int64_t end, int) {
+    for (int64_t i = begin; i < end; ++i) {
+      out[4 * i] = in[3 * i];
+      out[4 * i + 1] = in[3 * i + 1];
+      out[4 * i + 2] = in[3 * i + 2];
+      out[4 * i + 3] = 1.0f;
+    }
+  });
+  return image_array(out, owner, height, width, 4, cuda_device);
 }
 
 // Renders with the GIL released; the progress callback and Ctrl-C are looked at
-// between passes with it held. A Python exception (KeyboardInterrupt, or one the
+// wherever the render tells its progress (app/session.hpp), with it held. A Python exception (KeyboardInterrupt, or one the
 // callback raised) stops the render there and is raised once it has returned.
 nb::tuple render(const PyScene& scene, const nb::object& progress, const std::string& device, const nb::kwargs& kwargs) {
   if (device != "cpu" && device != "cuda") throw wt::InputError("device: must be 'cpu' or 'cuda' (got '" + device + "')");
@@ -204,10 +221,10 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
   nb::object noisy = nb::none();
   nb::object image;
   if (job.denoise) {
-    image = image_array(rgba_of(done.denoised), h, w, 4, on);
-    noisy = image_array(rgba_of(out.result.rgb), h, w, 4, on);
+    image = rgba_array(done.denoised, h, w, on);
+    noisy = rgba_array(out.result.rgb, h, w, on);
   } else {
-    image = image_array(rgba_of(out.result.rgb), h, w, 4, on);
+    image = rgba_array(out.result.rgb, h, w, on);
   }
   return nb::make_tuple(image, scene.session->stats(job, out).dump(), aovs, noisy);
 }

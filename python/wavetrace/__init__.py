@@ -48,17 +48,19 @@ class CudaImage:
     """A rendered image in CUDA device memory (render(..., device="cuda")): a float32
     (H, W, 4) array that torch.from_dlpack and cupy.from_dlpack read where it lies,
     without a copy, with `stats`, `aovs` (arrays on the device too) and `noisy` as
-    Image has them. numpy() copies it to the host."""
+    Image has them (each AOV an array that torch and cupy read the same way).
+    numpy() copies it to the host."""
 
-    def __init__(self, array: Any, stats: dict, aovs: dict, noisy: Optional[CudaImage]):
+    def __init__(self, array: Any, shape: tuple, stats: dict, aovs: dict, noisy: Optional[CudaImage]):
         self._array = array
+        self._shape = tuple(shape)
         self.stats = stats
         self.aovs = aovs
         self.noisy = noisy
 
     @property
     def shape(self) -> tuple:
-        return tuple(self._array.shape)
+        return self._shape
 
     @property
     def dtype(self) -> _np.dtype:
@@ -98,12 +100,16 @@ def render(scene: Scene, progress: Optional[Callable[[float], None]] = None, dev
     the next (scene.uploads counts them; scene.release_devices() frees them).
 
     progress: called with the share done (0 to 1) as the render goes. Ctrl-C stops
-    the render at its next pass and raises KeyboardInterrupt; the scene stays usable.
+    the render where it next tells its progress (each bounce of a wavefront; each
+    of the CUDA megakernel's passes, at least ten a render) and raises
+    KeyboardInterrupt; the scene stays usable.
     """
     array, stats, aovs, noisy = _wavetrace.render(scene, progress, device, **settings)
     stats = _json.loads(stats)
     if device == "cuda":
-        return CudaImage(array, stats, dict(aovs), None if noisy is None else CudaImage(noisy, stats, {}, None))
+        shape = (stats["settings"]["height"], stats["settings"]["width"], 4)
+        return CudaImage(array, shape, stats, dict(aovs),
+                         None if noisy is None else CudaImage(noisy, shape, stats, {}, None))
     image = array.view(Image)
     image.stats = stats
     image.aovs = {name: _np.asarray(a) for name, a in aovs.items()}

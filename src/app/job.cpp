@@ -19,6 +19,7 @@
 #include "app/progress.hpp"
 #include "app/signals.hpp"
 #include "app/stats.hpp"
+#include "cpu/parallel.hpp"
 #include "device/device.hpp"
 #include "errors/errors.hpp"
 #include "image/denoise.hpp"
@@ -67,10 +68,16 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
 const std::string& checkpoint_of(const Job& job) { return job.checkpoint.empty() ? job.resume : job.checkpoint; }
 
 uint64_t count_nonfinite_pixels(const std::vector<float>& rgb) {
-  uint64_t n = 0;
-  for (size_t p = 0; p + 2 < rgb.size(); p += 3) {
-    n += !(std::isfinite(rgb[p]) && std::isfinite(rgb[p + 1]) && std::isfinite(rgb[p + 2]));
-  }
+  std::atomic<uint64_t> n{0};
+  const float* v = rgb.data();
+  cpu::parallel_for(static_cast<int64_t>(rgb.size() / 3), int64_t(1) << 16, cpu::thread_count(0),
+                    [v, &n](int64_t begin, int64_t end, int) {
+                      uint64_t here = 0;
+                      for (int64_t p = 3 * begin; p < 3 * end; p += 3) {
+                        here += !(std::isfinite(v[p]) && std::isfinite(v[p + 1]) && std::isfinite(v[p + 2]));
+                      }
+                      n += here;
+                    });
   return n;
 }
 

@@ -42,20 +42,26 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   out.load_times = scene_->load_times;
   out.geometry = scene_->summary();
   out.scene_warnings = scene_->warnings;
-  if (progress) options.progress = [&progress](double done, uint64_t, double) { progress(done); };
+  // A stop is asked wherever the render tells its progress (each bounce of a
+  // wavefront, each row chunk of the CPU megakernel, each pass of the CUDA
+  // megakernel, each step of an adaptive render), so that the render keeps its own
+  // passes and speed; a stop unwinds it from there.
+  struct Stopped {};
+  if (progress || stop) {
+    options.progress = [&progress, &stop](double done, uint64_t, double) {
+      if (progress) progress(done);
+      if (stop && stop()) throw Stopped{};
+    };
+  }
   AdaptiveHooks hooks;
-  if (stop) {
-    if (options.noise_threshold != 0) {
-      hooks.after_step = [&stop](const AdaptiveState&, bool) { return !stop(); };
-    } else {
-      // Passes of 1/256 of the samples, as a checkpointed `render` takes them: a stop
-      // is answered within one.
-      options.samples_per_pass = std::max(1, options.params.spp / 256);
-      options.after_pass = [&stop](int32_t, const FilmReader&) { return !stop(); };
-    }
+  if (stop && options.noise_threshold != 0) {
+    hooks.after_step = [&stop](const AdaptiveState&, bool) { return !stop(); };
   }
   try {
     out.result = wt::render(*scene_, options, hooks);
+  } catch (const Stopped&) {
+    out.result = RenderResult{};
+    out.result.interrupted = true;
   } catch (const DeviceError&) {
     // As run_job does: an error that left the context usable is cleared, so that the
     // next render (and the kept copies, still valid) can run.

@@ -34,13 +34,15 @@ class Session {
   // Renders the scene with the job's settings, its AOVs and its denoiser (its scene,
   // output, stats, checkpoint and keep_noisy fields are not read). On the CUDA backend
   // the scene is uploaded to a device at its first render there and kept for the
-  // next (uploads() counts them); renders may run from several threads at once. `progress`: the share done, called from the
-  // rendering thread; `stop`: asked after every pass (a uniform render then takes
-  // passes of 1/256 of its samples, as a checkpointed `render` does; an adaptive one
-  // asks after each step), true ends the render there (the outcome's result then says
-  // interrupted, and no AOV or denoiser runs). Throws InputError for bad settings and
-  // DeviceError when the machine fails, as run_job reports them. The result holds
-  // each pixel's mean radiance.
+  // next (uploads() counts them); renders may run from several threads at once.
+  // `progress`: the share done, called from the rendering thread; `stop`: asked
+  // wherever the render tells its progress (each bounce of a wavefront, each chunk
+  // of rows of the CPU megakernel, each of the CUDA megakernel's passes, at least
+  // ten; each step of an adaptive render), so that the render keeps the passes and
+  // the speed it has without them. True ends the render there (the outcome's result
+  // then says interrupted and holds no image, and no AOV or denoiser runs). Throws
+  // InputError for bad settings and DeviceError when the machine fails, as run_job
+  // reports them. The result holds each pixel's mean radiance.
   SessionRender render(const Job& job, const std::function<void(double)>& progress = {},
                        const std::function<bool()>& stop = {}) const;
 

@@ -215,9 +215,11 @@ class DeviceLease {
       std::vector<ResidentScenes::Slot>& slots = resident_->by_device[device];
       for (size_t i = 0; i < slots.size() && !copy_; ++i) {
         if (slots[i].held) continue;
-        // The scene is there: only the render's own state must fit beside it.
-        const DeviceInfo now = device_info();
-        require_device_memory(rp, state_bytes(slots[i].copy->info), now.free_memory, now.name);
+        // The scene is there: only the render's own state must fit beside it (the free
+        // memory read alone: the device's properties are the copy's).
+        size_t free_now = 0, total = 0;
+        WT_CUDA(cudaMemGetInfo(&free_now, &total), "device query");
+        require_device_memory(rp, state_bytes(slots[i].copy->info), free_now, slots[i].copy->info.name);
         slots[i].held = true;
         copy_ = slots[i].copy;
         device_ = device;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cpu/cpu_backend.hpp"
+#include "cpu/parallel.hpp"
 #include "cuda/cuda_backend.hpp"
 #include "dispatch/split.hpp"
 #include "render/adaptive.hpp"
@@ -157,7 +158,12 @@ int64_t scene_uploads(const ResidentScenes* resident) { return resident ? cuda::
 
 void take_mean(RenderResult& r) {
   const float inv = 1.0f / static_cast<float>(r.samples);
-  for (float& v : r.rgb) v *= inv;
+  // Over the host's threads: a 1080p film is 6 M floats, a share of a short render.
+  float* v = r.rgb.data();
+  cpu::parallel_for(static_cast<int64_t>(r.rgb.size()), int64_t(1) << 18, cpu::thread_count(0),
+                    [v, inv](int64_t begin, int64_t end, int) {
+                      for (int64_t i = begin; i < end; ++i) v[i] *= inv;
+                    });
   r.radiance = Radiance::MeanOfSamples;
 }
 
