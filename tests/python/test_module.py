@@ -213,7 +213,14 @@ def test_bad_input_raises_the_commands_messages(tmp_path):
             wt.render(scene, backend="cuda", **{k: v for k, v in small().items() if k != "backend"})
 
 
-def test_ctrl_c_stops_a_render_within_a_second_and_the_scene_stays_usable():
+@pytest.mark.parametrize("backend,kernel,size,spp", [
+    ("cpu", "megakernel", (160, 120), 1024),
+    # About 2 s on an H100, stopped after its bounce in flight.
+    pytest.param("cuda", "wavefront", (1920, 1080), 1024, marks=needs_cuda),
+    # About 2 s in passes of a tenth: the pass in flight and the one queued behind it
+    # finish before the render unwinds.
+    pytest.param("cuda", "megakernel", (1920, 1080), 512, marks=needs_cuda)])
+def test_ctrl_c_stops_a_render_within_a_second_and_the_scene_stays_usable(backend, kernel, size, spp):
     scene = wt.load_scene(str(CORNELL))
     sent = []
 
@@ -224,10 +231,11 @@ def test_ctrl_c_stops_a_render_within_a_second_and_the_scene_stays_usable():
 
     threading.Thread(target=interrupt).start()
     with pytest.raises(KeyboardInterrupt):
-        # 1/256 of the render a pass: 4 samples of 160 x 120, about 50 ms on two cores.
-        wt.render(scene, width=160, height=120, spp=1024, backend="cpu", kernel="megakernel")
+        # The CPU megakernel looks between chunks of rows; the CUDA one between its
+        # passes (at least ten a render).
+        wt.render(scene, width=size[0], height=size[1], spp=spp, backend=backend, kernel=kernel)
     assert sent and time.monotonic() - sent[0] < 1.0
-    img = wt.render(scene, **small())
+    img = wt.render(scene, **small(backend=backend, kernel=kernel))
     assert img.shape == (32, 48, 4)
 
 
