@@ -214,7 +214,8 @@ def test_bad_input_raises_the_commands_messages(tmp_path):
 
 
 @pytest.mark.parametrize("backend,kernel,size,spp", [
-    ("cpu", "megakernel", (160, 120), 1024),
+    # Rows of 640 x 64 samples a chunk: short enough on a loaded two-core machine.
+    ("cpu", "megakernel", (640, 480), 64),
     # About 2 s on an H100, stopped after its bounce in flight.
     pytest.param("cuda", "wavefront", (1920, 1080), 1024, marks=needs_cuda),
     # About 2 s in passes of a tenth: the pass in flight and the one queued behind it
