@@ -103,9 +103,14 @@ wt::app::Job job_from(const nb::kwargs& kwargs) {
     for (const wt::Setting& s : wt::settings()) {
       if (key == s.key) found = &s;
     }
+    if (found != nullptr && found->id == wt::SettingId::CheckpointEvery) {
+      throw wt::InputError(key + ": a render in memory keeps no checkpoint (the command's --checkpoint does)");
+    }
     if (found == nullptr) {
       std::string known = "backend, kernel, devices, aovs, denoise, denoise_quality";
-      for (const wt::Setting& s : wt::settings()) known += std::string(", ") + s.key;
+      for (const wt::Setting& s : wt::settings()) {
+        if (s.id != wt::SettingId::CheckpointEvery) known += std::string(", ") + s.key;
+      }
       throw wt::InputError("render: unknown setting '" + key + "' (known: " + known + ")");
     }
     if (found->type == wt::SettingType::Real) {
@@ -310,9 +315,11 @@ NB_MODULE(_wavetrace, m) {
   m.def("aov_names", [] { return wt::aov_names(); }, "The AOVs render(aovs=...) returns.");
   m.def("settings", [] {
     std::vector<std::string> keys;
-    for (const wt::Setting& s : wt::settings()) keys.push_back(s.key);
+    for (const wt::Setting& s : wt::settings()) {
+      if (s.id != wt::SettingId::CheckpointEvery) keys.push_back(s.key);  // the command's files alone
+    }
     return keys;
-  });
+  }, "The keys of the settings table that render() takes.");
   m.def("write_image", &write_image, nb::arg("image"), nb::arg("path"), nb::arg("encoding") = "srgb",
         "Writes an (H, W, 3 or 4) float32 image: PNG (encoded), PFM or OpenEXR (linear), by extension.");
 }

@@ -196,6 +196,8 @@ def test_bad_input_raises_the_commands_messages(tmp_path):
         wt.render(scene, sppp=4)
     with pytest.raises(ValueError, match=r"^spp: must be an integer"):
         wt.render(scene, spp=4.5)
+    with pytest.raises(ValueError, match=r"^checkpoint_every: a render in memory keeps no checkpoint"):
+        wt.render(scene, checkpoint_every=60)
     missing = tmp_path / "missing.json"
     with pytest.raises(ValueError, match="^" + str(missing) + ": "):
         wt.load_scene(str(missing))
@@ -264,6 +266,7 @@ def test_write_image_writes_what_the_render_holds(tmp_path):
 def test_the_lists_name_what_the_command_takes():
     assert "wavefront" in wt.kernels("cpu") and "megakernel-constant" not in wt.kernels("cpu")
     assert {"spp", "width", "height", "seed", "noise_threshold"} <= set(wt.settings())
+    assert "checkpoint_every" not in wt.settings()
     assert wt.devices()[0] == {"backend": "cpu", "index": 0}
 
 
