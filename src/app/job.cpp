@@ -67,6 +67,11 @@ std::vector<int> parse_devices(const std::string& text, Backend backend, int pre
 
 const std::string& checkpoint_of(const Job& job) { return job.checkpoint.empty() ? job.resume : job.checkpoint; }
 
+void check_denoiser(const std::string& field) {
+  std::string why;
+  if (!oidn_available(why)) throw InputError(field + ": " + why);
+}
+
 uint64_t count_nonfinite_pixels(const std::vector<float>& rgb) {
   std::atomic<uint64_t> n{0};
   const float* v = rgb.data();
@@ -232,10 +237,7 @@ void check_outputs(const Job& job, bool distributed) {
     }
   }
   if (job.keep_noisy && !job.denoise) throw InputError("--keep-noisy: keeps the render beside a denoised image: give --denoise too");
-  if (job.denoise) {
-    std::string why;
-    if (!oidn_available(why)) throw InputError("--denoise: " + why);
-  }
+  if (job.denoise) check_denoiser("--denoise");
   const std::string noisy = noisy_output(job);
   const std::vector<JobFile> aovs = aov_outputs(job);  // the --aov list checked
   check_output_path(job.output);

@@ -140,6 +140,9 @@ std::optional<int64_t> given_setting(const Job& job, SettingId id);
 // The checkpoint a job writes: --checkpoint, or else the --resume file (written back to).
 const std::string& checkpoint_of(const Job& job);
 
+// Throws InputError "<field>: <why>" where Open Image Denoise cannot be loaded.
+void check_denoiser(const std::string& field);
+
 // Pixels (RGB triples) with a NaN or an infinity in any channel.
 uint64_t count_nonfinite_pixels(const std::vector<float>& rgb);
 

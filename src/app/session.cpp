@@ -8,7 +8,6 @@
 #include "app/job_files.hpp"
 #include "device/device.hpp"
 #include "dispatch/renderer.hpp"
-#include "image/denoise.hpp"
 
 namespace wt::app {
 
@@ -24,10 +23,7 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   JobOutcome& out = done.outcome;
   RenderOptions options = resolve_options(job, *scene_);
   job_aovs(job);  // the list checked before the render
-  if (job.denoise) {
-    std::string why;
-    if (!oidn_available(why)) throw InputError("denoise: " + why);
-  }
+  if (job.denoise) check_denoiser("denoise");
   if (options.backend == Backend::Cuda) {
     std::lock_guard<std::mutex> lock(resident_mutex_);
     if (!resident_) resident_ = keep_scene(*scene_, options.backend);

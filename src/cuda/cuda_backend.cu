@@ -184,7 +184,7 @@ struct ResidentScenes {
     bool held = false;
   };
   const Scene* scene = nullptr;
-  std::mutex mutex;
+  mutable std::mutex mutex;
   std::map<int, std::vector<Slot>> by_device;
   int64_t uploads = 0;
 };
@@ -209,10 +209,9 @@ class DeviceLease {
     }
     const RenderParams& rp = options.params;
     if (resident_) {
-      int device = 0;
-      WT_CUDA(cudaGetDevice(&device), "device selection");
+      WT_CUDA(cudaGetDevice(&device_), "device selection");
       std::lock_guard<std::mutex> lock(resident_->mutex);
-      std::vector<ResidentScenes::Slot>& slots = resident_->by_device[device];
+      std::vector<ResidentScenes::Slot>& slots = resident_->by_device[device_];
       for (size_t i = 0; i < slots.size() && !copy_; ++i) {
         if (slots[i].held) continue;
         // The scene is there: only the render's own state must fit beside it (the free
@@ -222,14 +221,12 @@ class DeviceLease {
         require_device_memory(rp, state_bytes(slots[i].copy->info), free_now, slots[i].copy->info.name);
         slots[i].held = true;
         copy_ = slots[i].copy;
-        device_ = device;
         slot_ = i;
       }
       if (!copy_) {
         copy_ = upload(scene, rp, state_bytes);
         slots.push_back({copy_, true});
         ++resident_->uploads;
-        device_ = device;
         slot_ = slots.size() - 1;
         uploaded_ = true;
       }
@@ -389,7 +386,7 @@ float* copy_to_device(const float* host, size_t n, int device) {
   constexpr const char* kHandOff = "image hand-off";
   WT_CUDA(cudaSetDevice(device), kHandOff);
   void* p = nullptr;
-  WT_CUDA(cudaMalloc(&p, n * sizeof(float)), kHandOff);
+  check_allocation(static_cast<int>(cudaMalloc(&p, n * sizeof(float))), n * sizeof(float), kHandOff);
   const cudaError_t copied = cudaMemcpy(p, host, n * sizeof(float), cudaMemcpyHostToDevice);
   if (copied != cudaSuccess) {
     cudaFree(p);
@@ -405,7 +402,7 @@ void copy_to_host(const float* on_device, size_t n, float* host) {
 }
 
 int64_t uploads(const ResidentScenes& resident) {
-  std::lock_guard<std::mutex> lock(const_cast<std::mutex&>(resident.mutex));
+  std::lock_guard<std::mutex> lock(resident.mutex);
   return resident.uploads;
 }
 
