@@ -9,7 +9,8 @@ For each kernel, the same render (scene, size, samples, seed, backend):
   render, write), and the process's wall clock;
 - the module, the scene loaded once and rendered once first (its upload), then
   `runs` timed calls of wavetrace.render: each call's wall clock in Python, and its
-  stats' `seconds`.
+  stats' `seconds`; the image returned as a numpy array (device "cpu": brought back
+  to the host once) and, on the CUDA backend, left on the device (device "cuda").
 
 The overhead is the module's call against the command's render: median call wall
 clock over median command `seconds`, less 1; and, within each call, its wall clock
@@ -47,13 +48,13 @@ def command_runs(args, kernel, tmp):
     return out
 
 
-def module_runs(args, kernel, scene):
+def module_runs(args, kernel, scene, device):
     settings = dict(width=args.width, height=args.height, spp=args.spp, seed=1, backend=args.backend, kernel=kernel)
-    wt.render(scene, **settings)  # the upload (CUDA), and the first render's set-up
+    wt.render(scene, device=device, **settings)  # the upload (CUDA), and the first render's set-up
     out = []
     for _ in range(args.runs):
         t0 = time.perf_counter()
-        img = wt.render(scene, **settings)
+        img = wt.render(scene, device=device, **settings)
         wall = time.perf_counter() - t0
         out.append({"call_seconds": wall, "seconds": img.stats["seconds"],
                     "upload_seconds": img.stats["upload_seconds"]})
@@ -69,39 +70,43 @@ def main():
     ap.add_argument("--width", type=int, default=1920)
     ap.add_argument("--height", type=int, default=1080)
     ap.add_argument("--spp", type=int, default=64)
-    ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--runs", type=int, default=5)
     ap.add_argument("--out", default=None, help="a JSON file of every run and the medians")
     args = ap.parse_args()
     kernels = args.kernels or wt.kernels(args.backend)
     scene = wt.load_scene(args.scene)
     rows = []
+    devices = ["cpu", "cuda"] if args.backend == "cuda" else ["cpu"]
     with tempfile.TemporaryDirectory() as tmp:
         for kernel in kernels:
             cli = command_runs(args, kernel, tmp)
-            mod = module_runs(args, kernel, scene)
             cli_render = statistics.median(r["seconds"] for r in cli)
-            call = statistics.median(r["call_seconds"] for r in mod)
-            added = statistics.median(r["call_seconds"] - r["seconds"] for r in mod)
-            rows.append({"kernel": kernel, "command": cli, "module": mod,
-                         "command_render_seconds": cli_render,
-                         "command_job_seconds": statistics.median(r["job_seconds"] for r in cli),
-                         "command_process_seconds": statistics.median(r["process_seconds"] for r in cli),
-                         "module_call_seconds": call,
-                         "module_render_seconds": statistics.median(r["seconds"] for r in mod),
-                         "module_added_seconds": added,
-                         "overhead_vs_command": call / cli_render - 1,
-                         "added_share": added / call})
+            for device in devices:
+                mod = module_runs(args, kernel, scene, device)
+                call = statistics.median(r["call_seconds"] for r in mod)
+                added = statistics.median(r["call_seconds"] - r["seconds"] for r in mod)
+                rows.append({"kernel": kernel, "device": device, "command": cli, "module": mod,
+                             "command_render_seconds": cli_render,
+                             "command_job_seconds": statistics.median(r["job_seconds"] for r in cli),
+                             "command_process_seconds": statistics.median(r["process_seconds"] for r in cli),
+                             "module_call_seconds": call,
+                             "module_render_seconds": statistics.median(r["seconds"] for r in mod),
+                             "module_added_seconds": added,
+                             "overhead_vs_command": call / cli_render - 1,
+                             "added_share": added / call})
     report = {"scene": args.scene, "backend": args.backend, "width": args.width, "height": args.height,
-              "spp": args.spp, "runs": args.runs, "uploads": scene.uploads, "rows": rows}
-    print("| kernel | command render s | command job s | module call s | module render s | added by the module | "
-          "call vs command render |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+              "spp": args.spp, "runs": args.runs, "uploads": scene.uploads,
+              "pinned_blocks": wt._wavetrace.pinned_allocations(), "rows": rows}
+    print("| kernel | image | command render s | command job s | module call s | module render s | "
+          "added by the module | call vs command render |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
     for r in rows:
-        print("| %s | %.4f | %.3f | %.4f | %.4f | %.1f ms (%.2f%%) | %+.2f%% |" % (
-            r["kernel"], r["command_render_seconds"], r["command_job_seconds"], r["module_call_seconds"],
-            r["module_render_seconds"], 1e3 * r["module_added_seconds"], 100 * r["added_share"],
-            100 * r["overhead_vs_command"]))
-    print("scene uploads through the module: %d" % scene.uploads)
+        print("| %s | %s | %.4f | %.3f | %.4f | %.4f | %.2f ms (%.2f%%) | %+.2f%% |" % (
+            r["kernel"], "numpy" if r["device"] == "cpu" else "cuda", r["command_render_seconds"],
+            r["command_job_seconds"], r["module_call_seconds"], r["module_render_seconds"],
+            1e3 * r["module_added_seconds"], 100 * r["added_share"], 100 * r["overhead_vs_command"]))
+    print("scene uploads through the module: %d; page-locked image blocks allocated: %d" % (
+        scene.uploads, report["pinned_blocks"]))
     if args.out:
         Path(args.out).write_text(json.dumps(report, indent=2) + "\n")
     return 0

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/job.hpp"
+#include "cuda/cuda_backend.hpp"
 #include "device/device.hpp"
 #include "dispatch/renderer.hpp"
 #include "dispatch/split.hpp"
@@ -379,6 +380,108 @@ TEST(ResidentScenes, OneUploadServesRendersOfAnySettings) {
   EXPECT_EQ(scene_uploads(kept.get()), 2);  // the second worker's copy, kept too
   render(quick(), twice);
   EXPECT_EQ(scene_uploads(kept.get()), 2);
+}
+
+// A render's image finished on its device (render_to_device: a session's renders that
+// keep their image there or bring it back once) holds the means render() brings back:
+// bit for bit where the kernel is (the same division by the samples, in single
+// precision), within the reordering bound for the wavefront; with warm-ups, and with
+// a kept copy. The options it does not take are refused.
+TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
+  WT_REQUIRE_CUDA();
+  const std::shared_ptr<ResidentScenes> kept = keep_scene(quick(), Backend::Cuda);
+  for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
+    for (int warmup : {0, 1}) {
+      const std::string what = std::string(kernel_name(k)) + " warm-ups " + std::to_string(warmup);
+      RenderOptions o = quick_options(Backend::Cuda, k, {0});
+      o.warmup = warmup;
+      const RenderResult host = render(quick(), o);
+      o.resident = kept;
+      cuda::DeviceImage image;
+      ASSERT_TRUE(renders_to_device(o));
+      RenderResult on = render_to_device(quick(), o, image);
+      EXPECT_TRUE(on.rgb.empty()) << what;
+      EXPECT_EQ(on.radiance, Radiance::MeanOfSamples) << what;
+      ASSERT_TRUE(image.rgba) << what;
+      EXPECT_EQ(image.device, 0);
+      const size_t pixels = host.rgb.size() / 3;
+      std::vector<float> rgba(pixels * 4);
+      cuda::copy_to_host(image.rgba.get(), rgba.size(), rgba.data());
+      for (size_t p = 0; p < pixels; ++p) {
+        ASSERT_EQ(rgba[4 * p + 3], 1.0f) << what << " alpha of pixel " << p;
+        for (int c = 0; c < 3; ++c) on.rgb.push_back(rgba[4 * p + c]);
+      }
+      expect_same_image(host, on, !is_wavefront(k), what);
+      EXPECT_EQ(image.nonfinite_pixels, app::count_nonfinite_pixels(host.rgb)) << what;
+    }
+  }
+  EXPECT_EQ(scene_uploads(kept.get()), 1);
+  RenderOptions adaptive = quick_options(Backend::Cuda, Kernel::Wavefront, {0});
+  adaptive.noise_threshold = 0.05;
+  RenderOptions two = quick_options(Backend::Cuda, Kernel::Megakernel, {0, 0});
+  RenderOptions cpu = quick_options(Backend::Cpu, Kernel::Megakernel, {});
+  for (const RenderOptions* o : {&adaptive, &two, &cpu}) {
+    EXPECT_FALSE(renders_to_device(*o));
+    cuda::DeviceImage image;
+    EXPECT_THROW(render_to_device(quick(), *o, image), std::logic_error);
+  }
+}
+
+// The finishing kernel over a film of known sums, with a NaN, both infinities and a
+// subnormal among them: its means are take_mean's bit for bit (the NaN a NaN), and it
+// counts the pixels count_nonfinite_pixels counts. The pixels are more than a block.
+TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
+  WT_REQUIRE_CUDA();
+  RenderResult host;
+  host.samples = 7;
+  const size_t pixels = 1000;
+  for (size_t i = 0; i < pixels * 3; ++i) host.rgb.push_back(static_cast<float>(i % 97) * 0.37f + 1e-3f);
+  host.rgb[3 * 3 + 1] = std::nanf("");
+  host.rgb[3 * 10] = INFINITY;
+  host.rgb[3 * 999 + 2] = -INFINITY;
+  host.rgb[3 * 500] = 3e-39f;  // subnormal
+  host.rgb[3 * 501] = 3e38f;   // finite, its mean too
+  float* film = cuda::copy_to_device(host.rgb.data(), host.rgb.size(), 0);
+  const cuda::DeviceImage image = cuda::finish_image(film, pixels, host.samples);
+  cuda::free_on_device(film);
+  cuda::PinnedImages blocks(2);
+  const std::shared_ptr<float> rgba = cuda::to_host(image, pixels * 4, blocks);
+  take_mean(host);
+  for (size_t p = 0; p < pixels; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      const float want = host.rgb[3 * p + c], got = rgba.get()[4 * p + c];
+      if (std::isnan(want)) {
+        EXPECT_TRUE(std::isnan(got)) << p;
+      } else {
+        ASSERT_EQ(want, got) << "pixel " << p << " channel " << c;
+      }
+    }
+    ASSERT_EQ(rgba.get()[4 * p + 3], 1.0f) << p;
+  }
+  EXPECT_EQ(image.nonfinite_pixels, 3u);
+  EXPECT_EQ(image.nonfinite_pixels, app::count_nonfinite_pixels(host.rgb));
+}
+
+// The page-locked blocks images come back to: one whose owner let go serves the next
+// image of its size; up to two are kept, and a block of another size is new.
+TEST(ImageOnDevice, PinnedBlocksServeTheNextImageOfTheirSize) {
+  WT_REQUIRE_CUDA();
+  cuda::PinnedImages blocks(2);
+  {
+    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
+    EXPECT_NE(a.get(), b.get());
+    EXPECT_EQ(blocks.allocations(), 2);
+  }
+  {
+    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
+    EXPECT_EQ(blocks.allocations(), 2);  // both kept ones
+    const std::shared_ptr<float> c = blocks.take(1000);
+    EXPECT_EQ(blocks.allocations(), 3);
+  }
+  const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000), c = blocks.take(1000);
+  EXPECT_EQ(blocks.allocations(), 4);  // of the three let go, two were kept
+  const std::shared_ptr<float> other = blocks.take(10);
+  EXPECT_EQ(blocks.allocations(), 5);
 }
 
 // Two GPUs where the machine has them: the split over both is the one-GPU image,

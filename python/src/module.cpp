@@ -138,27 +138,31 @@ PyScene make_scene(wt::Scene scene, const std::string& source) {
   return PyScene{std::make_shared<wt::app::Session>(std::make_shared<const wt::Scene>(std::move(scene)), source)};
 }
 
-// An image of floats (H, W, C) at `data`, kept alive by `owner`: in host memory, a
-// numpy array; in CUDA device `cuda_device`'s memory (>= 0), copied there into an
-// array that hands itself over by DLPack (torch.from_dlpack, cupy.from_dlpack read
-// it where it lies).
-nb::object image_array(const float* data, const nb::capsule& owner, size_t height, size_t width, size_t channels,
-                       int cuda_device) {
-  if (cuda_device < 0) {
-    return nb::cast(nb::ndarray<nb::numpy, float>(const_cast<float*>(data), {height, width, channels}, owner));
-  }
-  const size_t n = height * width * channels;
-  float* on_device = wt::cuda::copy_to_device(data, n, cuda_device);
-  nb::capsule device_owner(on_device, [](void* p) noexcept { wt::cuda::free_on_device(p); });
+// `data`'s (H, W, C) floats as an array where they lie, kept alive by the array: in
+// host memory (cuda_device < 0), a numpy array; in the memory of CUDA device
+// `cuda_device`, an array that hands itself over by DLPack (torch.from_dlpack,
+// cupy.from_dlpack read it where it lies).
+nb::object array_of(std::shared_ptr<float> data, size_t height, size_t width, size_t channels, int cuda_device) {
+  float* at = data.get();
+  auto* kept = new std::shared_ptr<float>(std::move(data));
+  nb::capsule owner(kept, [](void* p) noexcept { delete static_cast<std::shared_ptr<float>*>(p); });
+  if (cuda_device < 0) return nb::cast(nb::ndarray<nb::numpy, float>(at, {height, width, channels}, owner));
   return nb::cast(nb::ndarray<nb::array_api, float, nb::device::cuda>(
-      on_device, {height, width, channels}, device_owner, {}, nb::dtype<float>(), nb::device::cuda::value,
-      cuda_device));
+      at, {height, width, channels}, owner, {}, nb::dtype<float>(), nb::device::cuda::value, cuda_device));
+}
+
+// Host values as an array on CUDA device `cuda_device` (copied there), or on the host
+// where it is below 0.
+nb::object image_array(std::shared_ptr<float> host, size_t height, size_t width, size_t channels, int cuda_device) {
+  if (cuda_device < 0) return array_of(std::move(host), height, width, channels, -1);
+  float* on_device = wt::cuda::copy_to_device(host.get(), height * width * channels, cuda_device);
+  return array_of(std::shared_ptr<float>(on_device, [](float* p) { wt::cuda::free_on_device(p); }), height, width,
+                  channels, cuda_device);
 }
 
 nb::object image_array(std::vector<float> values, size_t height, size_t width, size_t channels, int cuda_device) {
-  auto* owned = new std::vector<float>(std::move(values));
-  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<float>*>(p); });
-  return image_array(owned->data(), owner, height, width, channels, cuda_device);
+  auto owned = std::make_shared<std::vector<float>>(std::move(values));
+  return image_array(std::shared_ptr<float>(owned, owned->data()), height, width, channels, cuda_device);
 }
 
 // Pixels of 3 floats as an (H, W, 4) image, alpha 1, written over the host's
@@ -166,18 +170,25 @@ nb::object image_array(std::vector<float> values, size_t height, size_t width, s
 // a short render).
 nb::object rgba_array(const std::vector<float>& rgb, size_t height, size_t width, int cuda_device) {
   const int64_t pixels = static_cast<int64_t>(rgb.size() / 3);
-  float* out = new float[static_cast<size_t>(pixels) * 4];
-  nb::capsule owner(out, [](void* p) noexcept { delete[] static_cast<float*>(p); });
+  std::shared_ptr<float> out(new float[static_cast<size_t>(pixels) * 4], std::default_delete<float[]>());
   const float* in = rgb.data();
-  wt::cpu::parallel_for(pixels, int64_t(1) << 16, wt::cpu::thread_count(0), [in, out](int64_t begin, int64_t end, int) {
+  float* to = out.get();
+  wt::cpu::parallel_for(pixels, int64_t(1) << 16, wt::cpu::thread_count(0), [in, to](int64_t begin, int64_t end, int) {
     for (int64_t i = begin; i < end; ++i) {
-      out[4 * i] = in[3 * i];
-      out[4 * i + 1] = in[3 * i + 1];
-      out[4 * i + 2] = in[3 * i + 2];
-      out[4 * i + 3] = 1.0f;
+      to[4 * i] = in[3 * i];
+      to[4 * i + 1] = in[3 * i + 1];
+      to[4 * i + 2] = in[3 * i + 2];
+      to[4 * i + 3] = 1.0f;
     }
   });
-  return image_array(out, owner, height, width, 4, cuda_device);
+  return image_array(std::move(out), height, width, 4, cuda_device);
+}
+
+// The page-locked memory that images finished on a device are brought back to, kept
+// from one render to the next (cuda/device_image.hpp).
+wt::cuda::PinnedImages& pinned_images() {
+  static wt::cuda::PinnedImages images(2);
+  return images;
 }
 
 // Renders with the GIL released; the progress callback and Ctrl-C are looked at
@@ -208,14 +219,28 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
     return pending.has_value();
   };
   wt::app::SessionRender done;
+  // An image finished on its CUDA device (a render with no AOV and no denoiser) is
+  // handed over there (device "cuda"), or brought back once into page-locked memory.
+  std::shared_ptr<float> brought_back;
   {
     nb::gil_scoped_release released;
     done = scene.session->render(job, on_progress, stop);
+    if (done.image.rgba && device == "cpu" && !pending) {
+      const wt::RenderParams& p = done.outcome.params;
+      brought_back = wt::cuda::to_host(done.image, static_cast<size_t>(p.width) * p.height * 4, pinned_images());
+      done.image.rgba.reset();
+    }
   }
   if (pending) throw std::move(*pending);
   const wt::app::JobOutcome& out = done.outcome;
   const wt::RenderParams& p = out.params;
   const size_t h = p.height, w = p.width;
+  const std::string stats = scene.session->stats(job, out).dump();
+  if (brought_back) return nb::make_tuple(array_of(std::move(brought_back), h, w, 4, -1), stats, nb::dict(), nb::none());
+  if (done.image.rgba) {
+    return nb::make_tuple(array_of(std::move(done.image.rgba), h, w, 4, done.image.device), stats, nb::dict(),
+                          nb::none());
+  }
   const int on = device == "cuda" ? done.cuda_device : -1;
   nb::dict aovs;
   for (wt::AovImage& a : done.aovs) {
@@ -231,7 +256,7 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
   } else {
     image = rgba_array(out.result.rgb, h, w, on);
   }
-  return nb::make_tuple(image, scene.session->stats(job, out).dump(), aovs, noisy);
+  return nb::make_tuple(image, stats, aovs, noisy);
 }
 
 void write_image(nb::ndarray<const float, nb::ndim<3>, nb::c_contig, nb::device::cpu> image, const std::string& path,
@@ -312,6 +337,10 @@ NB_MODULE(_wavetrace, m) {
         return nb::ndarray<nb::numpy, float>(owned->data(), shape.size(), shape.data(), owner);
       },
       nb::arg("array"), "A float32 array in CUDA device memory, copied to a numpy array.");
+  m.def(
+      "pinned_allocations", [] { return pinned_images().allocations(); },
+      "The blocks of page-locked host memory allocated so far for images brought back from a CUDA device (a "
+      "block whose image is freed is kept for the next image of its size).");
   m.def("aov_names", [] { return wt::aov_names(); }, "The AOVs render(aovs=...) returns.");
   m.def("settings", [] {
     std::vector<std::string> keys;

@@ -53,8 +53,11 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   if (stop && options.noise_threshold != 0) {
     hooks.after_step = [&stop](const AdaptiveState&, bool) { return !stop(); };
   }
+  // A render that needs no image on the host for its AOVs or its denoiser keeps its
+  // image on the device it ran on, for the caller to take from there or bring back.
+  const bool on_device = renders_to_device(options) && !job.denoise && job_aovs(job).empty();
   try {
-    out.result = wt::render(*scene_, options, hooks);
+    out.result = on_device ? render_to_device(*scene_, options, done.image) : wt::render(*scene_, options, hooks);
   } catch (const Stopped&) {
     out.result = RenderResult{};
     out.result.interrupted = true;
@@ -64,7 +67,7 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
     cuda::recover_after_error();
     throw;
   }
-  out.nonfinite_pixels = count_nonfinite_pixels(out.result.rgb);
+  out.nonfinite_pixels = done.image.rgba ? done.image.nonfinite_pixels : count_nonfinite_pixels(out.result.rgb);
   if (!out.result.interrupted) {
     options.progress = nullptr;
     render_first_surface(job, *scene_, options, out);

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/job.hpp"
+#include "cuda/device_image.hpp"
 
 namespace wt::app {
 
@@ -24,6 +25,10 @@ struct SessionRender {
   std::vector<float> denoised;  // the denoiser's image (width x height x 3) where the job denoises
   std::vector<AovImage> aovs;   // the job's AOVs (its `aov` list), in its order
   int cuda_device = 0;          // the CUDA device it ran on (the first of several); 0 on the CPU
+  // A render on one CUDA device with no AOV and no denoiser: its image, finished on
+  // the device (cuda/device_image.hpp), and the outcome's result.rgb is empty. Null
+  // rgba otherwise.
+  cuda::DeviceImage image;
 };
 
 class Session {
@@ -42,7 +47,8 @@ class Session {
   // the speed it has without them. True ends the render there (the outcome's result
   // then says interrupted and holds no image, and no AOV or denoiser runs). Throws
   // InputError for bad settings and DeviceError when the machine fails, as run_job
-  // reports them. The result holds each pixel's mean radiance.
+  // reports them. The result holds each pixel's mean radiance, or the render's image
+  // on its CUDA device holds them (SessionRender::image).
   SessionRender render(const Job& job, const std::function<void(double)>& progress = {},
                        const std::function<bool()>& stop = {}) const;
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,7 @@ struct DeviceCopy {
   std::unique_ptr<DeviceScene> ds;
   double upload_seconds = 0;
   WaveRenderer waves;
+  DeviceBuffer<float> film;  // render_image's, kept for the next render of its size
 };
 
 }  // namespace
@@ -310,6 +312,8 @@ class Uploaded {
     return FilmSums{kept_host_->get(), kept_host_->size()};
   }
 
+  DeviceCopy& copy() const { return lease_.copy(); }
+
   RenderResult render(const RenderOptions& options) const {
     DeviceCopy& copy = lease_.copy();
     RenderResult out = is_wavefront(options.kernel)
@@ -351,6 +355,36 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
   const Uploaded uploaded(scene, options);
   RenderResult out = uploaded.render(options);
+  if (options.progress) options.progress(1.0, out.rays, out.seconds);
+  return out;
+}
+
+RenderResult render_image(const Scene& scene, const RenderOptions& options, DeviceImage& image) {
+  if (options.initial_film || options.after_pass || options.path_feed || options.device_film ||
+      options.active_pixels || options.devices.size() > 1) {
+    throw std::logic_error("cuda: render_image renders a whole film from sample 0 on one device");
+  }
+  if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
+  const Uploaded uploaded(scene, options);
+  const RenderParams& rp = options.params;
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  // The render adds into a film the copy keeps, which it neither clears nor brings
+  // back; its warm-ups render into it first, untimed, as they do into their own.
+  DeviceBuffer<float>& film = uploaded.copy().film;
+  if (film.size() != pixels * 3) film.allocate(pixels * 3, kStage);
+  RenderOptions into = options;
+  into.device_film = film.get();
+  into.warmup = 0;
+  for (int i = 0; i < options.warmup; ++i) {
+    RenderOptions warm = into;
+    warm.progress = nullptr;
+    film.zero(kStage);
+    uploaded.render(warm);
+  }
+  film.zero(kStage);
+  RenderResult out = uploaded.render(into);
+  image = finish_image(film.get(), pixels, out.samples);
+  out.radiance = Radiance::MeanOfSamples;
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;
 }

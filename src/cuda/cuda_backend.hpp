@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "cuda/device_image.hpp"
 #include "render/aovs.hpp"
 #include "render/device_renderer.hpp"
 #include "render/render_types.hpp"
@@ -19,6 +20,11 @@ void check_devices(const RenderOptions& options);
 // none); the result holds pixel sums (dispatch/renderer.hpp divides). The dispatcher
 // splits a render over several devices with device_renderer.
 RenderResult render(const Scene& scene, const RenderOptions& options);
+
+// The same render of a whole film (from sample 0, no adaptive rounds) on that one
+// device, its image finished there (device_image.hpp) instead of brought back: the
+// result's rgb is empty, and `image` holds each pixel's mean.
+RenderResult render_image(const Scene& scene, const RenderOptions& options, DeviceImage& image);
 
 // Device i of options.devices, one of several: made current on the calling thread
 // (the split's thread for it), the scene uploaded there, and each chunk rendered

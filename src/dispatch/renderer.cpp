@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "cpu/cpu_backend.hpp"
@@ -126,6 +127,20 @@ void validate_render(const RenderOptions& options) {
                      " values; a " + std::to_string(p.width) + " x " + std::to_string(p.height) + " film holds " +
                      std::to_string(film_floats));
   }
+}
+
+bool renders_to_device(const RenderOptions& options) {
+  return options.backend == Backend::Cuda && options.devices.size() <= 1 && options.noise_threshold == 0 &&
+         options.first_sample == 0 && !options.initial_film && !options.after_pass && !options.path_feed &&
+         !options.device_film && !options.active_pixels;
+}
+
+RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image) {
+  if (!renders_to_device(options)) throw std::logic_error("render_to_device: options it does not take");
+  validate_render(options);
+  check_kernel_runs(options);
+  cuda::check_devices(options);
+  return cuda::render_image(scene, options, image);
 }
 
 RenderResult render_sums(const Scene& scene, const RenderOptions& options) {

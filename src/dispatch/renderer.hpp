@@ -2,6 +2,7 @@
 // radiance, counted rays and timings back.
 #pragma once
 
+#include "cuda/device_image.hpp"
 #include "render/adaptive.hpp"
 #include "render/aovs.hpp"
 #include "render/render_types.hpp"
@@ -29,6 +30,13 @@ ChunkRenderer adaptive_rounds(const Scene& scene, const RenderOptions& options);
 // MPI run's ranks), its settings checked first.
 RenderResult render_adaptive_rounds(const ChunkRenderer& rounds, const RenderOptions& options,
                                     const AdaptiveHooks& hooks);
+// Whether render_to_device takes these options: the CUDA backend on one device, a
+// render of a whole film from sample 0 that is not adaptive.
+bool renders_to_device(const RenderOptions& options);
+// render() of such options, its image finished on the device it ran on
+// (cuda/device_image.hpp) instead of brought back: the result's rgb is empty, and
+// `image` holds the means render() would have returned, bit for bit.
+RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image);
 // The same render, its result the pixels' sums over the samples it rendered
 // (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
 // sums are added to others' (the ranks of an MPI run).

@@ -147,6 +147,33 @@ def test_a_cuda_image_is_handed_over_by_dlpack():
                                                                             kernel="megakernel")).aovs["normal"])
 
 
+@needs_cuda
+@pytest.mark.parametrize("kernel", ["megakernel", "wavefront"])
+def test_an_image_finished_on_the_device_is_the_hosts(kernel):
+    """A render with no AOV and no denoiser finishes its image on the device: handed
+    over there (device="cuda") or brought back once into page-locked memory, which
+    the next image of its size reuses. Either is the image of a render whose AOVs made
+    it come back as sums and be finished on the host."""
+    scene = wt.load_scene(str(CORNELL))
+    settings = small(backend="cuda", kernel=kernel, width=400, height=300)
+    through_host = wt.render(scene, aovs=["albedo"], **settings)
+    on_gpu = wt.render(scene, device="cuda", **settings)
+    brought_back = wt.render(scene, **settings)
+    if kernel == "megakernel":
+        np.testing.assert_array_equal(on_gpu.numpy(), through_host)
+        np.testing.assert_array_equal(brought_back, through_host)
+    else:
+        np.testing.assert_allclose(on_gpu.numpy(), through_host, rtol=1e-5, atol=1e-6)
+        np.testing.assert_allclose(brought_back, through_host, rtol=1e-5, atol=1e-6)
+    assert brought_back.stats["nonfinite_pixels"] == through_host.stats["nonfinite_pixels"] == 0
+    del brought_back
+    blocks = wt._wavetrace.pinned_allocations()
+    for _ in range(4):
+        img = wt.render(scene, **settings)
+        del img
+    assert wt._wavetrace.pinned_allocations() == blocks  # the block let go served each
+
+
 def test_a_cuda_image_needs_a_device():
     if HAS_CUDA:
         pytest.skip("a CUDA device is present")

@@ -1,0 +1,49 @@
+// A render's image finished on the device it was rendered on (cuda_backend.hpp's
+// render_to_device): each pixel's mean made there, so that an image handed over in
+// device memory (the Python module's device="cuda") never crosses to the host, and
+// one brought back crosses once, into page-locked memory kept for the next.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+namespace wt::cuda {
+
+// Each pixel's mean as RGBA (4 floats a pixel, alpha 1, row 0 the top) in memory of
+// CUDA device `device` that the image owns (freed when the last owner lets go), and
+// how many pixels hold a value that is not finite.
+struct DeviceImage {
+  std::shared_ptr<float> rgba;
+  int device = 0;
+  uint64_t nonfinite_pixels = 0;
+};
+
+// The film's sums of `samples` samples per pixel (3 floats a pixel, on the current
+// device) as the image of their means: each sum times 1 / samples in single
+// precision, as take_mean (dispatch/renderer.hpp) makes them on the host, so that
+// the two agree bit for bit; and a pixel is counted as count_nonfinite_pixels
+// (app/job.hpp) counts it.
+DeviceImage finish_image(const float* film, size_t pixels, int32_t samples);
+
+// Page-locked host memory for images brought back from a device, which the device
+// copies into at full speed. Allocating it costs milliseconds (a share of a short
+// render), so a block whose last owner lets go is kept for the next image of its size,
+// up to `keep` blocks; more are freed.
+class PinnedImages {
+ public:
+  explicit PinnedImages(size_t keep = 2);
+  // Memory for `floats` values: a kept block of that size, or a new one.
+  std::shared_ptr<float> take(size_t floats);
+  // The blocks allocated so far (kept ones reused are not counted again).
+  int64_t allocations() const;
+
+ private:
+  struct Pool;
+  std::shared_ptr<Pool> pool_;
+};
+
+// The image's `floats` values copied into a block of `memory`.
+std::shared_ptr<float> to_host(const DeviceImage& image, size_t floats, PinnedImages& memory);
+
+}  // namespace wt::cuda
