@@ -442,28 +442,43 @@ TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   host.rgb[3 * 500] = 3e-39f;  // subnormal
   host.rgb[3 * 501] = 3e38f;   // finite, its mean too
   float* film = cuda::copy_to_device(host.rgb.data(), host.rgb.size(), 0);
-  const cuda::DeviceImage image = cuda::finish_image(film, pixels, host.samples);
-  cuda::free_on_device(film);
+  // Into device memory it allocates, and into a page-locked block the kernel writes
+  // across the bus.
+  cuda::DeviceImage on_device;
+  cuda::finish_image(film, pixels, host.samples, on_device);
   cuda::PinnedImages blocks(2);
-  const std::shared_ptr<float> rgba = cuda::to_host(image, pixels * 4, blocks);
+  cuda::DeviceImage on_host;
+  on_host.rgba = blocks.take(pixels * 4);
+  const float* block = on_host.rgba.get();
+  cuda::finish_image(film, pixels, host.samples, on_host);
+  cuda::free_on_device(film);
+  EXPECT_EQ(on_host.rgba.get(), block);  // written where it was given
+  std::vector<float> from_device(pixels * 4);
+  cuda::copy_to_host(on_device.rgba.get(), from_device.size(), from_device.data());
   take_mean(host);
-  for (size_t p = 0; p < pixels; ++p) {
-    for (int c = 0; c < 3; ++c) {
-      const float want = host.rgb[3 * p + c], got = rgba.get()[4 * p + c];
-      if (std::isnan(want)) {
-        EXPECT_TRUE(std::isnan(got)) << p;
-      } else {
-        ASSERT_EQ(want, got) << "pixel " << p << " channel " << c;
+  for (const float* rgba : {static_cast<const float*>(from_device.data()), block}) {
+    for (size_t p = 0; p < pixels; ++p) {
+      for (int c = 0; c < 3; ++c) {
+        const float want = host.rgb[3 * p + c], got = rgba[4 * p + c];
+        if (std::isnan(want)) {
+          EXPECT_TRUE(std::isnan(got)) << p;
+        } else {
+          ASSERT_EQ(want, got) << "pixel " << p << " channel " << c;
+        }
       }
+      ASSERT_EQ(rgba[4 * p + 3], 1.0f) << p;
     }
-    ASSERT_EQ(rgba.get()[4 * p + 3], 1.0f) << p;
   }
-  EXPECT_EQ(image.nonfinite_pixels, 3u);
-  EXPECT_EQ(image.nonfinite_pixels, app::count_nonfinite_pixels(host.rgb));
+  for (const cuda::DeviceImage* image : {&on_device, &on_host}) {
+    EXPECT_EQ(image->nonfinite_pixels, 3u);
+    EXPECT_EQ(image->nonfinite_pixels, app::count_nonfinite_pixels(host.rgb));
+    EXPECT_EQ(image->device, 0);
+  }
 }
 
 // The page-locked blocks images come back to: one whose owner let go serves the next
-// image of its size; up to two are kept, and a block of another size is new.
+// image of its size; the two let go last are kept (blocks of an earlier size give way
+// to those of the size now rendered), and a block of another size is new.
 TEST(ImageOnDevice, PinnedBlocksServeTheNextImageOfTheirSize) {
   WT_REQUIRE_CUDA();
   cuda::PinnedImages blocks(2);
@@ -478,9 +493,16 @@ TEST(ImageOnDevice, PinnedBlocksServeTheNextImageOfTheirSize) {
     const std::shared_ptr<float> c = blocks.take(1000);
     EXPECT_EQ(blocks.allocations(), 3);
   }
-  const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000), c = blocks.take(1000);
-  EXPECT_EQ(blocks.allocations(), 4);  // of the three let go, two were kept
-  const std::shared_ptr<float> other = blocks.take(10);
+  {
+    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000), c = blocks.take(1000);
+    EXPECT_EQ(blocks.allocations(), 4);  // of the three let go, two were kept
+  }
+  // Two blocks of 1000 kept; renders of another size take their place one by one.
+  for (int i = 0; i < 3; ++i) {
+    const std::shared_ptr<float> other = blocks.take(10);
+    EXPECT_EQ(blocks.allocations(), 5);
+  }
+  const std::shared_ptr<float> kept = blocks.take(1000);  // the one block of 1000 still kept
   EXPECT_EQ(blocks.allocations(), 5);
 }
 

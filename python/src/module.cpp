@@ -220,26 +220,22 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
   };
   wt::app::SessionRender done;
   // An image finished on its CUDA device (a render with no AOV and no denoiser) is
-  // handed over there (device "cuda"), or brought back once into page-locked memory.
-  std::shared_ptr<float> brought_back;
+  // handed over there (device "cuda"), or written by the device straight into
+  // page-locked host memory (device "cpu"), which is then the numpy array's.
+  wt::app::ImageMemory memory;
+  if (device == "cpu") memory = [](size_t floats) { return pinned_images().take(floats); };
   {
     nb::gil_scoped_release released;
-    done = scene.session->render(job, on_progress, stop);
-    if (done.image.rgba && device == "cpu" && !pending) {
-      const wt::RenderParams& p = done.outcome.params;
-      brought_back = wt::cuda::to_host(done.image, static_cast<size_t>(p.width) * p.height * 4, pinned_images());
-      done.image.rgba.reset();
-    }
+    done = scene.session->render(job, on_progress, stop, memory);
   }
   if (pending) throw std::move(*pending);
   const wt::app::JobOutcome& out = done.outcome;
   const wt::RenderParams& p = out.params;
   const size_t h = p.height, w = p.width;
   const std::string stats = scene.session->stats(job, out).dump();
-  if (brought_back) return nb::make_tuple(array_of(std::move(brought_back), h, w, 4, -1), stats, nb::dict(), nb::none());
   if (done.image.rgba) {
-    return nb::make_tuple(array_of(std::move(done.image.rgba), h, w, 4, done.image.device), stats, nb::dict(),
-                          nb::none());
+    return nb::make_tuple(array_of(std::move(done.image.rgba), h, w, 4, device == "cpu" ? -1 : done.image.device),
+                          stats, nb::dict(), nb::none());
   }
   const int on = device == "cuda" ? done.cuda_device : -1;
   nb::dict aovs;

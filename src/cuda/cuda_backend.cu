@@ -383,7 +383,7 @@ RenderResult render_image(const Scene& scene, const RenderOptions& options, Devi
   }
   film.zero(kStage);
   RenderResult out = uploaded.render(into);
-  image = finish_image(film.get(), pixels, out.samples);
+  finish_image(film.get(), pixels, out.samples, image);
   out.radiance = Radiance::MeanOfSamples;
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;

@@ -3,6 +3,7 @@
 #include <cuda_runtime.h>
 
 #include <cub/block/block_reduce.cuh>
+#include <iterator>
 #include <mutex>
 #include <utility>
 #include <vector>
@@ -40,34 +41,47 @@ __global__ void __launch_bounds__(kBlock)
 
 }  // namespace
 
-DeviceImage finish_image(const float* film, size_t pixels, int32_t samples) {
-  DeviceImage out;
-  WT_CUDA(cudaGetDevice(&out.device), kFinish);
-  const size_t bytes = pixels * 4 * sizeof(float);
-  void* rgba = nullptr;
-  check_allocation(static_cast<int>(cudaMalloc(&rgba, bytes)), bytes, kFinish);
-  // Freed where the last owner lets go (a DLPack consumer's, maybe); an error there
-  // surfaces at the next call, as DeviceBuffer's does.
-  out.rgba = std::shared_ptr<float>(static_cast<float*>(rgba), [](float* p) { cudaFree(p); });
+void finish_image(const float* film, size_t pixels, int32_t samples, DeviceImage& image) {
+  WT_CUDA(cudaGetDevice(&image.device), kFinish);
+  float* rgba = image.rgba.get();
+  if (rgba == nullptr) {
+    const size_t bytes = pixels * 4 * sizeof(float);
+    void* p = nullptr;
+    check_allocation(static_cast<int>(cudaMalloc(&p, bytes)), bytes, kFinish);
+    // Freed where the last owner lets go (a DLPack consumer's, maybe); an error there
+    // surfaces at the next call, as DeviceBuffer's does.
+    image.rgba = std::shared_ptr<float>(static_cast<float*>(p), [](float* q) { cudaFree(q); });
+    rgba = image.rgba.get();
+  } else {
+    // Page-locked host memory as the device addresses it (the same address where
+    // addressing is unified, as on every 64-bit system).
+    cudaPointerAttributes at{};
+    WT_CUDA(cudaPointerGetAttributes(&at, rgba), kFinish);
+    if (at.type == cudaMemoryTypeHost) {
+      void* on_device = nullptr;
+      WT_CUDA(cudaHostGetDevicePointer(&on_device, rgba, 0), kFinish);
+      rgba = static_cast<float*>(on_device);
+    }
+  }
   DeviceBuffer<unsigned long long> count(1, kFinish);
   count.zero(kFinish);
   if (pixels > 0) {
     const float inv = 1.0f / static_cast<float>(samples);  // take_mean's factor
     finish_pixels<<<static_cast<unsigned>((pixels + kBlock - 1) / kBlock), kBlock>>>(
-        film, pixels, inv, static_cast<float4*>(rgba), count.get());
+        film, pixels, inv, reinterpret_cast<float4*>(rgba), count.get());
     WT_CUDA_LAUNCHED("finish_pixels", kFinish);
   }
+  // The count comes back after the kernel: the image is then written, wherever it lies.
   unsigned long long nonfinite = 0;
   WT_CUDA(cudaMemcpy(&nonfinite, count.get(), sizeof(nonfinite), cudaMemcpyDeviceToHost), kFinish);
-  out.nonfinite_pixels = nonfinite;
-  return out;
+  image.nonfinite_pixels = nonfinite;
 }
 
 struct PinnedImages::Pool {
   std::mutex mutex;
   size_t keep = 0;
   int64_t allocations = 0;
-  std::vector<std::pair<size_t, float*>> free;  // (floats, block)
+  std::vector<std::pair<size_t, float*>> free;  // (floats, block), the last let go last
   ~Pool() {
     for (const auto& block : free) cudaFreeHost(block.second);
   }
@@ -79,17 +93,18 @@ std::shared_ptr<float> PinnedImages::take(size_t floats) {
   float* block = nullptr;
   {
     std::lock_guard<std::mutex> lock(pool_->mutex);
-    for (auto it = pool_->free.begin(); it != pool_->free.end(); ++it) {
+    for (auto it = pool_->free.rbegin(); it != pool_->free.rend(); ++it) {
       if (it->first == floats) {
         block = it->second;
-        pool_->free.erase(it);
+        pool_->free.erase(std::next(it).base());
         break;
       }
     }
   }
   if (block == nullptr) {
     void* p = nullptr;
-    WT_CUDA(cudaMallocHost(&p, floats * sizeof(float)), kHandOff);
+    // Mapped (the device writes it: finish_image) and usable from every device.
+    WT_CUDA(cudaHostAlloc(&p, floats * sizeof(float), cudaHostAllocMapped | cudaHostAllocPortable), kHandOff);
     block = static_cast<float*>(p);
     std::lock_guard<std::mutex> lock(pool_->mutex);
     ++pool_->allocations;
@@ -98,10 +113,10 @@ std::shared_ptr<float> PinnedImages::take(size_t floats) {
   std::shared_ptr<Pool> pool = pool_;
   return std::shared_ptr<float>(block, [pool, floats](float* p) {
     std::lock_guard<std::mutex> lock(pool->mutex);
-    if (pool->free.size() < pool->keep) {
-      pool->free.emplace_back(floats, p);
-    } else {
-      cudaFreeHost(p);
+    pool->free.emplace_back(floats, p);
+    if (pool->free.size() > pool->keep) {
+      cudaFreeHost(pool->free.front().second);  // the block let go longest ago
+      pool->free.erase(pool->free.begin());
     }
   });
 }
@@ -109,12 +124,6 @@ std::shared_ptr<float> PinnedImages::take(size_t floats) {
 int64_t PinnedImages::allocations() const {
   std::lock_guard<std::mutex> lock(pool_->mutex);
   return pool_->allocations;
-}
-
-std::shared_ptr<float> to_host(const DeviceImage& image, size_t floats, PinnedImages& memory) {
-  std::shared_ptr<float> host = memory.take(floats);
-  WT_CUDA(cudaMemcpy(host.get(), image.rgba.get(), floats * sizeof(float), cudaMemcpyDeviceToHost), kHandOff);
-  return host;
 }
 
 }  // namespace wt::cuda

@@ -23,13 +23,16 @@ struct DeviceImage {
 // device) as the image of their means: each sum times 1 / samples in single
 // precision, as take_mean (dispatch/renderer.hpp) makes them on the host, so that
 // the two agree bit for bit; and a pixel is counted as count_nonfinite_pixels
-// (app/job.hpp) counts it.
-DeviceImage finish_image(const float* film, size_t pixels, int32_t samples);
+// (app/job.hpp) counts it. Written into `image.rgba` where the caller gave memory
+// there (pixels x 4 floats): device memory, or page-locked host memory (PinnedImages),
+// which the kernel writes across the bus, so that an image wanted on the host
+// crosses once with no copy of its own; else into device memory it allocates.
+void finish_image(const float* film, size_t pixels, int32_t samples, DeviceImage& image);
 
 // Page-locked host memory for images brought back from a device, which the device
-// copies into at full speed. Allocating it costs milliseconds (a share of a short
-// render), so a block whose last owner lets go is kept for the next image of its size,
-// up to `keep` blocks; more are freed.
+// writes at full speed. Allocating it costs milliseconds (a share of a short render),
+// so a block whose last owner lets go is kept for the next image of its size: the
+// `keep` blocks let go last are kept, older ones freed.
 class PinnedImages {
  public:
   explicit PinnedImages(size_t keep = 2);
@@ -42,8 +45,5 @@ class PinnedImages {
   struct Pool;
   std::shared_ptr<Pool> pool_;
 };
-
-// The image's `floats` values copied into a block of `memory`.
-std::shared_ptr<float> to_host(const DeviceImage& image, size_t floats, PinnedImages& memory);
 
 }  // namespace wt::cuda
