@@ -222,7 +222,7 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
   // An image finished on its CUDA device (a render with no AOV and no denoiser) is
   // handed over there (device "cuda"), or written by the device straight into
   // page-locked host memory (device "cpu"), which is then the numpy array's.
-  wt::app::ImageMemory memory;
+  wt::cuda::ImageMemory memory;
   if (device == "cpu") memory = [](size_t floats) { return pinned_images().take(floats); };
   {
     nb::gil_scoped_release released;

@@ -15,7 +15,7 @@ Session::Session(std::shared_ptr<const Scene> scene, std::string source)
     : scene_(std::move(scene)), source_(std::move(source)) {}
 
 SessionRender Session::render(const Job& given, const std::function<void(double)>& progress,
-                              const std::function<bool()>& stop, const ImageMemory& image_memory) const {
+                              const std::function<bool()>& stop, const cuda::ImageMemory& image_memory) const {
   const auto start = std::chrono::steady_clock::now();
   Job job = given;
   job.scene = source_;
@@ -56,11 +56,9 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   // A render that needs no image on the host for its AOVs or its denoiser keeps its
   // image on the device it ran on, for the caller to take from there or bring back.
   const bool on_device = renders_to_device(options) && !job.denoise && job_aovs(job).empty();
-  if (on_device && image_memory) {
-    done.image.rgba = image_memory(static_cast<size_t>(options.params.width) * options.params.height * 4);
-  }
   try {
-    out.result = on_device ? render_to_device(*scene_, options, done.image) : wt::render(*scene_, options, hooks);
+    out.result = on_device ? render_to_device(*scene_, options, done.image, image_memory)
+                           : wt::render(*scene_, options, hooks);
   } catch (const Stopped&) {
     out.result = RenderResult{};
     out.result.interrupted = true;

@@ -31,11 +31,6 @@ struct SessionRender {
   cuda::DeviceImage image;
 };
 
-// Memory for the `floats` values of an image that a CUDA render finishes where it ran
-// (SessionRender::image), which the device writes: page-locked host memory
-// (cuda::PinnedImages) for an image wanted on the host. Empty: device memory.
-using ImageMemory = std::function<std::shared_ptr<float>(size_t floats)>;
-
 class Session {
  public:
   // `scene` as loaded from `source`, the name the messages and the stats give it.
@@ -54,9 +49,10 @@ class Session {
   // InputError for bad settings and DeviceError when the machine fails, as run_job
   // reports them. The result holds each pixel's mean radiance, or the render's image
   // on its CUDA device holds them (SessionRender::image).
-  // `image_memory`: where an image finished on the device is written.
+  // `image_memory`: where an image finished on the device is written (page-locked host
+  // memory for an image wanted on the host); empty: device memory.
   SessionRender render(const Job& job, const std::function<void(double)>& progress = {},
-                       const std::function<bool()>& stop = {}, const ImageMemory& image_memory = {}) const;
+                       const std::function<bool()>& stop = {}, const cuda::ImageMemory& image_memory = {}) const;
 
   // What `--stats` writes for that render.
   nlohmann::json stats(const Job& job, const JobOutcome& outcome) const;

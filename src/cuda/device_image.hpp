@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 namespace wt::cuda {
@@ -18,6 +19,10 @@ struct DeviceImage {
   int device = 0;
   uint64_t nonfinite_pixels = 0;
 };
+
+// Memory for the `floats` values of a DeviceImage, which the device writes: page-locked
+// host memory (PinnedImages) for an image wanted on the host.
+using ImageMemory = std::function<std::shared_ptr<float>(size_t floats)>;
 
 // The film's sums of `samples` samples per pixel (3 floats a pixel, on the current
 // device) as the image of their means: each sum times 1 / samples in single

@@ -135,11 +135,14 @@ bool renders_to_device(const RenderOptions& options) {
          !options.device_film && !options.active_pixels;
 }
 
-RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image) {
+RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image,
+                              const cuda::ImageMemory& memory) {
   if (!renders_to_device(options)) throw std::logic_error("render_to_device: options it does not take");
   validate_render(options);
   check_kernel_runs(options);
   cuda::check_devices(options);
+  image = cuda::DeviceImage{};
+  if (memory) image.rgba = memory(static_cast<size_t>(options.params.width) * options.params.height * 4);
   return cuda::render_image(scene, options, image);
 }
 

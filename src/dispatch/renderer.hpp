@@ -35,9 +35,11 @@ RenderResult render_adaptive_rounds(const ChunkRenderer& rounds, const RenderOpt
 bool renders_to_device(const RenderOptions& options);
 // render() of such options, its image finished on the device it ran on
 // (cuda/device_image.hpp) instead of brought back: the result's rgb is empty, and
-// `image` holds the means render() would have returned, bit for bit (in the memory its
-// rgba names where it names some: cuda::finish_image).
-RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image);
+// `image` holds the means render() would have returned, bit for bit: in memory from
+// `memory` where it is given (asked for once the render's settings and devices are
+// checked), else in device memory.
+RenderResult render_to_device(const Scene& scene, const RenderOptions& options, cuda::DeviceImage& image,
+                              const cuda::ImageMemory& memory = {});
 // The same render, its result the pixels' sums over the samples it rendered
 // (Radiance::SumOfSamples, with the initial film's): for a part of a render whose
 // sums are added to others' (the ranks of an MPI run).
