@@ -13,6 +13,7 @@ if [[ ! -f "$build/build.ninja" ]]; then
   # installs (WAVETRACE_PYTHON_EXE: another).
   python_exe=${WAVETRACE_PYTHON_EXE:-/usr/bin/python3}
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CUDA_ARCHITECTURES="$cuda_arch" \
+    -DWAVETRACE_DEVICE_OPT="$cuda_opt" \
     ${python_exe:+-DPython_EXECUTABLE="$python_exe"} >/dev/null
 fi
 cuda_arch_configure "$build"
