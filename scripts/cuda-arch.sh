@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # Sourced by the build scripts: the CUDA architectures to build device code for, in
-# $cuda_arch, and whether to optimize it, in $cuda_opt. $WAVETRACE_CUDA_ARCH where it is set; else 90 (the H100 and H200's
-# machine code) where this machine has an NVIDIA GPU; else 90-virtual: the device
-# code compiled to PTX only. That is still compiled and checked, but skips ptxas,
-# which takes most of a CUDA file's time (the megakernel's: 128 s instead of 437 s
-# on a 2-core machine): CI and the CPU backend have no GPU to run machine code on.
-# A PTX-only binary that meets a GPU later still runs there, after the driver
-# compiles the PTX on first use (minutes, then cached); scripts/gpu-build.sh builds
-# machine code for the GPU machine. PTX alone is compiled to check it, with NVVM's
-# optimizer off (WAVETRACE_DEVICE_OPT, CMakeLists.txt: the megakernel's PTX in 35 s
-# instead of 141 s), so such a binary on a GPU runs slower still; machine code is
+# $cuda_arch, and whether to optimize it, in $cuda_opt. $WAVETRACE_CUDA_ARCH where it is
+# set; else 90 (the H100 and H200's machine code) where this machine has an NVIDIA GPU;
+# else 90-virtual: the device code compiled to PTX only. That is still compiled and
+# checked, but skips ptxas, which takes most of a CUDA file's time (the megakernel's:
+# 128 s instead of 437 s on a 2-core machine): CI and the CPU backend have no GPU to run
+# machine code on. A PTX-only binary that meets a GPU later still runs there, after the
+# driver compiles the PTX on first use (minutes, then cached); scripts/gpu-build.sh
+# builds machine code for the GPU machine. PTX alone is compiled to check it, with
+# NVVM's optimizer off (WAVETRACE_DEVICE_OPT, CMakeLists.txt: the megakernel's PTX in
+# 35 s instead of 141 s), so such a binary on a GPU runs slower still; machine code is
 # optimized. WAVETRACE_CUDA_OPT=ON|OFF chooses otherwise.
 if [[ -n ${WAVETRACE_CUDA_ARCH:-} ]]; then
   cuda_arch=$WAVETRACE_CUDA_ARCH

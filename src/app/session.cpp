@@ -22,7 +22,7 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   SessionRender done;
   JobOutcome& out = done.outcome;
   RenderOptions options = resolve_options(job, *scene_);
-  job_aovs(job);  // the list checked before the render
+  const bool with_aovs = !job_aovs(job).empty();  // the list checked before the render
   if (job.denoise) check_denoiser("denoise");
   if (options.backend == Backend::Cuda) {
     std::lock_guard<std::mutex> lock(resident_mutex_);
@@ -55,7 +55,7 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   }
   // A render that needs no image on the host for its AOVs or its denoiser keeps its
   // image on the device it ran on, for the caller to take from there or bring back.
-  const bool on_device = renders_to_device(options) && !job.denoise && job_aovs(job).empty();
+  const bool on_device = renders_to_device(options) && !job.denoise && !with_aovs;
   try {
     out.result = on_device ? render_to_device(*scene_, options, done.image, image_memory)
                            : wt::render(*scene_, options, hooks);

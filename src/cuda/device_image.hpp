@@ -1,7 +1,8 @@
 // A render's image finished on the device it was rendered on (cuda_backend.hpp's
-// render_to_device): each pixel's mean made there, so that an image handed over in
-// device memory (the Python module's device="cuda") never crosses to the host, and
-// one brought back crosses once, into page-locked memory kept for the next.
+// render_image, which dispatch's render_to_device calls): each pixel's mean made there,
+// so that an image handed over in device memory (the Python module's device="cuda")
+// never crosses to the host, and one brought back crosses once, into page-locked memory
+// kept for the next.
 #pragma once
 
 #include <cstddef>
@@ -11,9 +12,11 @@
 
 namespace wt::cuda {
 
-// Each pixel's mean as RGBA (4 floats a pixel, alpha 1, row 0 the top) in memory of
-// CUDA device `device` that the image owns (freed when the last owner lets go), and
-// how many pixels hold a value that is not finite.
+// Each pixel's mean as RGBA (4 floats a pixel, alpha 1, row 0 the top), rendered on
+// CUDA device `device`, in memory the image owns (freed, or given back to its pool,
+// when the last owner lets go): that device's memory, or page-locked host memory
+// where the caller asked for it (ImageMemory); and how many pixels hold a value that
+// is not finite.
 struct DeviceImage {
   std::shared_ptr<float> rgba;
   int device = 0;
