@@ -36,7 +36,12 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
                                const RenderOptions& options, int sm_count) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
-  if (constant) upload_constant_scene(scene, view, ds.image_views());
+  if (constant) {
+    upload_constant_scene(scene, view, ds.image_views());
+    load_megakernel_constant(rp);
+  } else {
+    load_megakernel(view, rp);
+  }
   // The pixels a sample visits: options.active_pixels, on the device, or every one.
   const size_t pixels = rendered_pixels(options);
   DeviceBuffer<uint32_t> active(options.active_pixels ? pixels : 0, kStage);

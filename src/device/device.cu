@@ -49,6 +49,11 @@ void check(int code, const char* call, const char* stage) {
   throw CudaError(std::string(stage) + what + call + " failed: " + error_text(err));
 }
 
+void load_kernel(const void* kernel, const char* stage) {
+  cudaFuncAttributes attributes{};
+  WT_CUDA(cudaFuncGetAttributes(&attributes, kernel), stage);
+}
+
 void check_allocation(int code, size_t bytes, const char* stage) {
   if (code == cudaErrorMemoryAllocation) {
     cudaGetLastError();

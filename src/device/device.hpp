@@ -49,6 +49,11 @@ void check(int code, const char* call, const char* stage);
 // A device allocation of `bytes`: the same, with the size when the device is out of memory.
 void check_allocation(int code, size_t bytes, const char* stage);
 
+// Loads a kernel's code on the current device now. CUDA loads each kernel at its
+// first launch (lazy loading); a render loads the kernels it times before its timer
+// starts, so that the first render of a process times the render alone.
+void load_kernel(const void* kernel, const char* stage);
+
 enum class Recovery {
   Clean,  // the context was usable: any error left by the failed call is cleared
   Lost,   // the context is poisoned (a sticky error: an illegal address, a kernel that

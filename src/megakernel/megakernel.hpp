@@ -50,6 +50,10 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
 void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork work, float* running, bool first,
                             bool last, cudaStream_t stream);
 
+// Loads the kernels launch_megakernel and launch_megakernel_fold would run for this
+// scene and these settings (device.hpp's load_kernel).
+void load_megakernel(const SceneView& scene, const RenderParams& rp);
+
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();
 
@@ -59,5 +63,8 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
 
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelWork out,
                                 unsigned long long* rays, cudaStream_t stream);
+
+// Loads the kernel launch_megakernel_constant would run for the uploaded scene.
+void load_megakernel_constant(const RenderParams& rp);
 
 }  // namespace wt::cuda

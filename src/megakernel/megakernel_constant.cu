@@ -98,15 +98,30 @@ void upload_constant_scene(const Scene& scene, const SceneView& device_view, con
   g_kinds = device_view.kinds;
 }
 
+namespace {
+
+// Hands f the constant-memory megakernel compiled for the uploaded scene's kinds
+// (light sampling's code only where it has emitters to sample).
+template <class F>
+void with_constant_megakernel(const RenderParams& rp, F&& f) {
+  const uint32_t kinds_and_lights = g_kinds | (g_scene.samples_lights(rp) ? kLightSampling : 0u);
+  with_kinds(kinds_and_lights, [&](auto kinds) { f(megakernel_constant<decltype(kinds)::value>); });
+}
+
+}  // namespace
+
 void launch_megakernel_constant(const RenderParams& rp, int first_sample, int samples, MegakernelWork out,
                                 unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1, out), block(kMegakernelBlockX, kMegakernelBlockY);
-  const uint32_t kinds_and_lights = g_kinds | (g_scene.samples_lights(rp) ? kLightSampling : 0u);
-  with_kinds(kinds_and_lights, [&](auto kinds) {
-    megakernel_constant<decltype(kinds)::value>
-        <<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, out, rays);
+  with_constant_megakernel(rp, [&](auto kernel) {
+    kernel<<<grid, block, 0, stream>>>(g_scene, rp, first_sample, samples, out, rays);
   });
   WT_CUDA_LAUNCHED("megakernel_constant", "megakernel-constant");
+}
+
+void load_megakernel_constant(const RenderParams& rp) {
+  with_constant_megakernel(
+      rp, [](auto kernel) { load_kernel(reinterpret_cast<const void*>(kernel), "megakernel-constant"); });
 }
 
 }  // namespace wt::cuda

@@ -57,15 +57,30 @@ void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork 
   WT_CUDA_LAUNCHED("megakernel_fold", "megakernel");
 }
 
+namespace {
+
+// Hands f the megakernel compiled for the scene's kinds: light sampling's code is
+// compiled in only where the scene has emitters to sample.
+template <class F>
+void with_megakernel(const SceneView& scene, const RenderParams& rp, F&& f) {
+  const uint32_t kinds_and_lights = scene.kinds | (scene.samples_lights(rp) ? kLightSampling : 0u);
+  with_kinds(kinds_and_lights, [&](auto kinds) { f(megakernel_global<decltype(kinds)::value>); });
+}
+
+}  // namespace
+
 void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first_sample, int samples,
                        MegakernelWork out, unsigned long long* rays, cudaStream_t stream) {
   const dim3 grid = megakernel_grid(rp, out.radiance ? samples : 1, out), block(kMegakernelBlockX, kMegakernelBlockY);
-  // Light sampling's code is compiled in only where the scene has emitters to sample.
-  const uint32_t kinds_and_lights = scene.kinds | (scene.samples_lights(rp) ? kLightSampling : 0u);
-  with_kinds(kinds_and_lights, [&](auto kinds) {
-    megakernel_global<decltype(kinds)::value><<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, out, rays);
+  with_megakernel(scene, rp, [&](auto kernel) {
+    kernel<<<grid, block, 0, stream>>>(scene, rp, first_sample, samples, out, rays);
   });
   WT_CUDA_LAUNCHED("megakernel_global", "megakernel");
+}
+
+void load_megakernel(const SceneView& scene, const RenderParams& rp) {
+  with_megakernel(scene, rp, [](auto kernel) { load_kernel(reinterpret_cast<const void*>(kernel), "megakernel"); });
+  load_kernel(reinterpret_cast<const void*>(megakernel_fold), "megakernel");
 }
 
 }  // namespace wt::cuda
