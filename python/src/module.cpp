@@ -191,9 +191,10 @@ wt::cuda::PinnedImages& pinned_images() {
   return images;
 }
 
-// Renders with the GIL released; the progress callback and Ctrl-C are looked at
-// wherever the render tells its progress (app/session.hpp), with it held. A Python exception (KeyboardInterrupt, or one the
-// callback raised) stops the render there and is raised once it has returned.
+// Renders with the GIL released; the progress callback and Ctrl-C are looked at,
+// with it held, wherever the render tells its progress, at most every 10 ms
+// (app/session.hpp). A Python exception (KeyboardInterrupt, or one the callback
+// raised) stops the render there and is raised once it has returned.
 nb::tuple render(const PyScene& scene, const nb::object& progress, const std::string& device, const nb::kwargs& kwargs) {
   if (device != "cpu" && device != "cuda") throw wt::InputError("device: must be 'cpu' or 'cuda' (got '" + device + "')");
   const wt::app::Job job = job_from(kwargs);

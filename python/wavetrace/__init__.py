@@ -99,10 +99,11 @@ def render(scene: Scene, progress: Optional[Callable[[float], None]] = None, dev
     The scene is uploaded to a CUDA device at its first render there and kept for
     the next (scene.uploads counts them; scene.release_devices() frees them).
 
-    progress: called with the share done (0 to 1) as the render goes. Ctrl-C stops
-    the render where it next tells its progress (each bounce of a wavefront; each
-    of the CUDA megakernel's passes, at least ten a render) and raises
-    KeyboardInterrupt; the scene stays usable.
+    progress: called with the share done (0 to 1) as the render goes, at most
+    every 10 ms, and with 1 at the end. Ctrl-C stops the render where it next tells
+    its progress (each bounce of a wavefront; each of the CUDA megakernel's passes,
+    at least ten a render), looked at as often, and raises KeyboardInterrupt; the
+    scene stays usable.
     """
     array, stats, aovs, noisy = _wavetrace.render(scene, progress, device, **settings)
     stats = _json.loads(stats)

@@ -41,10 +41,17 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   // A stop is asked wherever the render tells its progress (each bounce of a
   // wavefront, each row chunk of the CPU megakernel, each pass of the CUDA
   // megakernel, each step of an adaptive render), so that the render keeps its own
-  // passes and speed; a stop unwinds it from there.
+  // passes and speed; a stop unwinds it from there. Both are asked at most every
+  // kAskEvery, and at the end: a wavefront's bounce can take a tenth of a
+  // millisecond, and the Python module takes the interpreter's lock for each ask.
   struct Stopped {};
   if (progress || stop) {
-    options.progress = [&progress, &stop](double done, uint64_t, double) {
+    static constexpr std::chrono::milliseconds kAskEvery{10};
+    options.progress = [&progress, &stop, asked = std::chrono::steady_clock::time_point{}](
+                           double done, uint64_t, double) mutable {
+      const auto now = std::chrono::steady_clock::now();
+      if (done < 1.0 && now - asked < kAskEvery) return;
+      asked = now;
       if (progress) progress(done);
       if (stop && stop()) throw Stopped{};
     };
