@@ -42,17 +42,19 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
   // wavefront, each row chunk of the CPU megakernel, each pass of the CUDA
   // megakernel, each step of an adaptive render), so that the render keeps its own
   // passes and speed; a stop unwinds it from there. Both are asked at most every
-  // kAskEvery, and at the end: a wavefront's bounce can take a tenth of a
-  // millisecond, and the Python module takes the interpreter's lock for each ask.
+  // kAskEvery: a wavefront's bounce can take a tenth of a millisecond, and the Python
+  // module takes the interpreter's lock for each ask. The render's own 1 (a wavefront
+  // tells it once its last path starts, and again at its end) is not passed on: the
+  // session tells 1 once the render has returned.
   struct Stopped {};
   if (progress || stop) {
     static constexpr std::chrono::milliseconds kAskEvery{10};
     options.progress = [&progress, &stop, asked = std::chrono::steady_clock::time_point{}](
                            double done, uint64_t, double) mutable {
       const auto now = std::chrono::steady_clock::now();
-      if (done < 1.0 && now - asked < kAskEvery) return;
+      if (now - asked < kAskEvery) return;
       asked = now;
-      if (progress) progress(done);
+      if (progress && done < 1.0) progress(done);
       if (stop && stop()) throw Stopped{};
     };
   }
@@ -76,6 +78,7 @@ SessionRender Session::render(const Job& given, const std::function<void(double)
     cuda::recover_after_error();
     throw;
   }
+  if (progress && !out.result.interrupted) progress(1.0);
   out.nonfinite_pixels = done.image.rgba ? done.image.nonfinite_pixels : count_nonfinite_pixels(out.result.rgb);
   if (!out.result.interrupted) {
     options.progress = nullptr;

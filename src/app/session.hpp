@@ -43,8 +43,9 @@ class Session {
   // `progress`: the share done, called from the rendering thread; `stop`: asked
   // wherever the render tells its progress (each bounce of a wavefront, each chunk
   // of rows of the CPU megakernel, each of the CUDA megakernel's passes, at least
-  // ten; each step of an adaptive render), at most every 10 ms and at the end, so
-  // that the render keeps the passes and the speed it has without them. True ends the render there (the outcome's result
+  // ten; each step of an adaptive render), at most every 10 ms, so that the render
+  // keeps the passes and the speed it has without them; progress is told 1 once, when
+  // the render has returned whole. True ends the render there (the outcome's result
   // then says interrupted and holds no image, and no AOV or denoiser runs). Throws
   // InputError for bad settings and DeviceError when the machine fails, as run_job
   // reports them. The result holds each pixel's mean radiance, or the render's image
