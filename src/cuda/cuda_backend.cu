@@ -59,6 +59,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   const int batch = options.megakernel_batch > 0
                         ? std::min(options.megakernel_batch, std::max(largest_pass, 1))
                         : megakernel_batch(static_cast<int64_t>(pixels), sm_count, largest_pass);
+  if (batch > 1) load_megakernel_fold();
   DeviceBuffer<float> radiance(batch > 1 ? pixels * 3 * batch : 0, kStage);
   DeviceBuffer<float> running(batch > 1 ? pixels * 3 : 0, kStage);
   // The work of a launch over the render's pixels: samples into `to_film`, or stored

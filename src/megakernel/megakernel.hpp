@@ -50,9 +50,13 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
 void launch_megakernel_fold(const RenderParams& rp, int samples, MegakernelWork work, float* running, bool first,
                             bool last, cudaStream_t stream);
 
-// Loads the kernels launch_megakernel and launch_megakernel_fold would run for this
-// scene and these settings (device.hpp's load_kernel).
+// Loads the kernel launch_megakernel would run for this scene and these settings
+// (device.hpp's load_kernel).
 void load_megakernel(const SceneView& scene, const RenderParams& rp);
+
+// Loads launch_megakernel_fold's kernel, which either megakernel's batches run (its
+// module is the global megakernel's, loaded with it: a tenth of a second on the H100).
+void load_megakernel_fold();
 
 // Bytes of __constant__ memory the constant-memory megakernel can hold a scene in.
 size_t constant_scene_capacity();

@@ -80,7 +80,8 @@ void launch_megakernel(const SceneView& scene, const RenderParams& rp, int first
 
 void load_megakernel(const SceneView& scene, const RenderParams& rp) {
   with_megakernel(scene, rp, [](auto kernel) { load_kernel(reinterpret_cast<const void*>(kernel), "megakernel"); });
-  load_kernel(reinterpret_cast<const void*>(megakernel_fold), "megakernel");
 }
+
+void load_megakernel_fold() { load_kernel(reinterpret_cast<const void*>(megakernel_fold), "megakernel"); }
 
 }  // namespace wt::cuda
