@@ -14,8 +14,10 @@ For each kernel, the same render (scene, size, samples, seed, backend):
 
 The overhead is the module's call against the command's render: median call wall
 clock over median command `seconds`, less 1; and, within each call, its wall clock
-less its own render `seconds` (what the module adds: bringing the film back, the
-mean, the RGBA array, the stats). The image before each call is let go outside it,
+less its own render `seconds` (what the module adds: on CUDA, finishing the image
+on the device and handing it over or writing it into host memory; on the CPU, the
+mean and the RGBA array; the settings, the lease of the kept scene, the stats). The
+image before each call is let go outside it,
 and that is timed on its own (a device image's memory is freed then; a numpy
 image's page-locked block goes back to its pool).
 
