@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/job.hpp"
+#include "cuda/buffer.hpp"
 #include "cuda/cuda_backend.hpp"
 #include "device/device.hpp"
 #include "dispatch/renderer.hpp"
@@ -390,6 +391,7 @@ TEST(ResidentScenes, OneUploadServesRendersOfAnySettings) {
 TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
   WT_REQUIRE_CUDA();
   const std::shared_ptr<ResidentScenes> kept = keep_scene(quick(), Backend::Cuda);
+  const float* last_block = nullptr;
   for (Kernel k : {Kernel::Megakernel, Kernel::MegakernelConstant, Kernel::Wavefront}) {
     for (int warmup : {0, 1}) {
       const std::string what = std::string(kernel_name(k)) + " warm-ups " + std::to_string(warmup);
@@ -400,6 +402,9 @@ TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
       cuda::DeviceImage image;
       ASSERT_TRUE(renders_to_device(o));
       RenderResult on = render_to_device(quick(), o, image);
+      // With the image before let go, the kept copy writes into its block again.
+      if (last_block != nullptr) EXPECT_EQ(image.rgba.get(), last_block) << what;
+      last_block = image.rgba.get();
       EXPECT_TRUE(on.rgb.empty()) << what;
       EXPECT_EQ(on.radiance, Radiance::MeanOfSamples) << what;
       ASSERT_TRUE(image.rgba) << what;
@@ -442,17 +447,21 @@ TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   host.rgb[3 * 500] = 3e-39f;  // subnormal
   host.rgb[3 * 501] = 3e38f;   // finite, its mean too
   float* film = cuda::copy_to_device(host.rgb.data(), host.rgb.size(), 0);
-  // Into device memory it allocates, and into a page-locked block the kernel writes
-  // across the bus.
+  // Into device memory, and into a page-locked block the kernel writes across the
+  // bus; the count's memory, given once, is cleared by each.
+  cuda::DeviceBuffer<unsigned long long> count(1, "test");
+  cuda::ImageBlocks device_blocks(cuda::ImageBlocks::Memory::Device), host_blocks(cuda::ImageBlocks::Memory::PageLocked);
   cuda::DeviceImage on_device;
-  cuda::finish_image(film, pixels, host.samples, on_device);
-  cuda::PinnedImages blocks(2);
+  on_device.rgba = device_blocks.take(pixels * 4);
+  cuda::finish_image(film, pixels, host.samples, count.get(), on_device);
   cuda::DeviceImage on_host;
-  on_host.rgba = blocks.take(pixels * 4);
+  on_host.rgba = host_blocks.take(pixels * 4);
   const float* block = on_host.rgba.get();
-  cuda::finish_image(film, pixels, host.samples, on_host);
+  cuda::finish_image(film, pixels, host.samples, count.get(), on_host);
   cuda::free_on_device(film);
   EXPECT_EQ(on_host.rgba.get(), block);  // written where it was given
+  cuda::DeviceImage none;
+  EXPECT_THROW(cuda::finish_image(film, pixels, host.samples, count.get(), none), std::logic_error);
   std::vector<float> from_device(pixels * 4);
   cuda::copy_to_host(on_device.rgba.get(), from_device.size(), from_device.data());
   take_mean(host);
@@ -476,34 +485,41 @@ TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   }
 }
 
-// The page-locked blocks images come back to: one whose owner let go serves the next
-// image of its size; the two let go last are kept (blocks of an earlier size give way
-// to those of the size now rendered), and a block of another size is new.
-TEST(ImageOnDevice, PinnedBlocksServeTheNextImageOfTheirSize) {
+// The blocks images are finished into, page-locked or on the device: one whose owner
+// let go serves the next image of its size; the two let go last are kept (blocks of
+// an earlier size give way to those of the size now rendered), and a block of another
+// size is new.
+TEST(ImageOnDevice, BlocksServeTheNextImageOfTheirSize) {
   WT_REQUIRE_CUDA();
-  cuda::PinnedImages blocks(2);
-  {
-    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
-    EXPECT_NE(a.get(), b.get());
-    EXPECT_EQ(blocks.allocations(), 2);
-  }
-  {
-    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
-    EXPECT_EQ(blocks.allocations(), 2);  // both kept ones
-    const std::shared_ptr<float> c = blocks.take(1000);
-    EXPECT_EQ(blocks.allocations(), 3);
-  }
-  {
-    const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000), c = blocks.take(1000);
-    EXPECT_EQ(blocks.allocations(), 4);  // of the three let go, two were kept
-  }
-  // Two blocks of 1000 kept; renders of another size take their place one by one.
-  for (int i = 0; i < 3; ++i) {
-    const std::shared_ptr<float> other = blocks.take(10);
+  for (cuda::ImageBlocks::Memory memory : {cuda::ImageBlocks::Memory::PageLocked, cuda::ImageBlocks::Memory::Device}) {
+    SCOPED_TRACE(memory == cuda::ImageBlocks::Memory::Device ? "device" : "page-locked");
+    cuda::ImageBlocks blocks(memory, 2);
+    float* first = nullptr;
+    {
+      const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
+      EXPECT_NE(a.get(), b.get());
+      EXPECT_EQ(blocks.allocations(), 2);
+      first = b.get();
+    }
+    {
+      const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
+      EXPECT_EQ(a.get(), first);  // the block let go last comes first
+      EXPECT_EQ(blocks.allocations(), 2);  // both kept ones
+      const std::shared_ptr<float> c = blocks.take(1000);
+      EXPECT_EQ(blocks.allocations(), 3);
+    }
+    {
+      const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000), c = blocks.take(1000);
+      EXPECT_EQ(blocks.allocations(), 4);  // of the three let go, two were kept
+    }
+    // Two blocks of 1000 kept; renders of another size take their place one by one.
+    for (int i = 0; i < 3; ++i) {
+      const std::shared_ptr<float> other = blocks.take(10);
+      EXPECT_EQ(blocks.allocations(), 5);
+    }
+    const std::shared_ptr<float> kept = blocks.take(1000);  // the one block of 1000 still kept
     EXPECT_EQ(blocks.allocations(), 5);
   }
-  const std::shared_ptr<float> kept = blocks.take(1000);  // the one block of 1000 still kept
-  EXPECT_EQ(blocks.allocations(), 5);
 }
 
 // Two GPUs where the machine has them: the split over both is the one-GPU image,

@@ -186,8 +186,8 @@ nb::object rgba_array(const std::vector<float>& rgb, size_t height, size_t width
 
 // The page-locked memory that images finished on a device are brought back to, kept
 // from one render to the next (cuda/device_image.hpp).
-wt::cuda::PinnedImages& pinned_images() {
-  static wt::cuda::PinnedImages images(2);
+wt::cuda::ImageBlocks& pinned_images() {
+  static wt::cuda::ImageBlocks images(wt::cuda::ImageBlocks::Memory::PageLocked, 2);
   return images;
 }
 

@@ -31,9 +31,10 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 
 // The megakernel renders in passes of samples (at least ten, so that progress can
 // be shown between them); the next pass is queued before the host waits on the
-// last one, unless after_pass must see each pass's film.
+// last one, unless after_pass must see each pass's film. `rays`: two counters on the
+// device (path rays, shadow rays), which the caller keeps from one render to the next.
 RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const SceneView& view,
-                               const RenderOptions& options, int sm_count) {
+                               const RenderOptions& options, int sm_count, unsigned long long* rays) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
   if (constant) {
@@ -50,7 +51,6 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   // The render's own film, or the one it adds into (options.device_film).
   DeviceBuffer<float> own_film(options.device_film ? 0 : film_floats, kStage);
   float* const film = options.device_film ? options.device_film : own_film.get();
-  DeviceBuffer<unsigned long long> rays(2, kStage);  // path rays, shadow rays
   const std::vector<SamplePass> passes = plan_passes(options, 10);
   // A small image's passes run in batches of samples (megakernel_batch), each
   // sample's radiance stored, then folded into running sums in sample order.
@@ -74,9 +74,9 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   };
   auto launch = [&](int first, int count, const MegakernelWork& out) {
     if (constant) {
-      launch_megakernel_constant(rp, first, count, out, rays.get(), nullptr);
+      launch_megakernel_constant(rp, first, count, out, rays, nullptr);
     } else {
-      launch_megakernel(view, rp, first, count, out, rays.get(), nullptr);
+      launch_megakernel(view, rp, first, count, out, rays, nullptr);
     }
   };
 
@@ -87,7 +87,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     } else {
       own_film.zero(kStage);  // nothing for a film of the caller's
     }
-    rays.zero(kStage);
+    WT_CUDA(cudaMemsetAsync(rays, 0, 2 * sizeof(unsigned long long)), kStage);
     out.samples = options.first_sample;
     out.interrupted = false;
     out.paths = 0;
@@ -119,7 +119,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
       if (last && options.progress && p > 0) {
         pass_done[p - 1].synchronize("megakernel");
         unsigned long long so_far = 0;
-        WT_CUDA(cudaMemcpy(&so_far, rays.get(), sizeof(so_far), cudaMemcpyDeviceToHost), "megakernel");
+        WT_CUDA(cudaMemcpy(&so_far, rays, sizeof(so_far), cudaMemcpyDeviceToHost), "megakernel");
         options.progress(static_cast<double>(p) / passes.size(), so_far, timer.elapsed_host());
       }
     }
@@ -128,7 +128,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   for (int i = 0; i < options.warmup; ++i) run(false);
   out.seconds = run(true);
   unsigned long long counted[2] = {0, 0};
-  WT_CUDA(cudaMemcpy(counted, rays.get(), sizeof(counted), cudaMemcpyDeviceToHost), kStage);
+  WT_CUDA(cudaMemcpy(counted, rays, sizeof(counted), cudaMemcpyDeviceToHost), kStage);
   out.rays = counted[0];
   out.shadow_rays = counted[1];
   if (!options.device_film) out.rgb = own_film.download(kStage);
@@ -163,10 +163,13 @@ namespace {
 
 // The scene on one device, uploaded once: with the device as it was read before the
 // upload (its free memory, which the wave size is chosen from, so that a kept copy's
-// renders choose what a fresh upload's would) and the wavefront's setup (pinned
-// counters, the wave's memory), kept from one of its renders to the next.
+// renders choose what a fresh upload's would) and what its renders set up, kept from
+// one to the next: the wavefront's (pinned counters, the wave's memory), the
+// megakernels' ray counters, and render_image's film, count and image memory.
+// (Device memory made and freed per render costs a free that waits for the device.)
 struct DeviceCopy {
-  DeviceCopy(const Scene& scene, const DeviceInfo& read_before) : info(read_before) {
+  DeviceCopy(const Scene& scene, const DeviceInfo& read_before)
+      : info(read_before), rays(2, kStage), nonfinite(1, kStage), images(ImageBlocks::Memory::Device) {
     const auto t0 = std::chrono::steady_clock::now();
     ds = std::make_unique<DeviceScene>(scene, scene.render.width, scene.render.height);
     WT_CUDA(cudaDeviceSynchronize(), "scene upload");
@@ -176,7 +179,10 @@ struct DeviceCopy {
   std::unique_ptr<DeviceScene> ds;
   double upload_seconds = 0;
   WaveRenderer waves;
-  DeviceBuffer<float> film;  // render_image's, kept for the next render of its size
+  DeviceBuffer<unsigned long long> rays;       // the megakernels' path and shadow rays
+  DeviceBuffer<float> film;                    // render_image's, kept for the next render of its size
+  DeviceBuffer<unsigned long long> nonfinite;  // render_image's count of non-finite pixels
+  ImageBlocks images;                          // render_image's images wanted in device memory
 };
 
 }  // namespace
@@ -324,7 +330,7 @@ class Uploaded {
     DeviceCopy& copy = lease_.copy();
     RenderResult out = is_wavefront(options.kernel)
                            ? copy.waves.render(view_, scene_.sort_key_bits(), options, wave_)
-                           : render_megakernel(scene_, *copy.ds, view_, options, copy.info.sm_count);
+                           : render_megakernel(scene_, *copy.ds, view_, options, copy.info.sm_count, copy.rays.get());
     out.upload_seconds = lease_.upload_seconds();
     out.device = copy.info.name;
     return out;
@@ -376,7 +382,8 @@ RenderResult render_image(const Scene& scene, const RenderOptions& options, Devi
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   // The render adds into a film the copy keeps, which it neither clears nor brings
   // back; its warm-ups render into it first, untimed, as they do into their own.
-  DeviceBuffer<float>& film = uploaded.copy().film;
+  DeviceCopy& copy = uploaded.copy();
+  DeviceBuffer<float>& film = copy.film;
   if (film.size() != pixels * 3) film.allocate(pixels * 3, kStage);
   RenderOptions into = options;
   into.device_film = film.get();
@@ -389,7 +396,8 @@ RenderResult render_image(const Scene& scene, const RenderOptions& options, Devi
   }
   film.zero(kStage);
   RenderResult out = uploaded.render(into);
-  finish_image(film.get(), pixels, out.samples, image);
+  if (!image.rgba) image.rgba = copy.images.take(pixels * 4);
+  finish_image(film.get(), pixels, out.samples, copy.nonfinite.get(), image);
   out.radiance = Radiance::MeanOfSamples;
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;

@@ -5,10 +5,10 @@
 #include <cub/block/block_reduce.cuh>
 #include <iterator>
 #include <mutex>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
-#include "cuda/buffer.hpp"
 #include "device/device.hpp"
 #include "device/kernel_bodies.hpp"
 
@@ -41,55 +41,60 @@ __global__ void __launch_bounds__(kBlock)
 
 }  // namespace
 
-void finish_image(const float* film, size_t pixels, int32_t samples, DeviceImage& image) {
+void finish_image(const float* film, size_t pixels, int32_t samples, unsigned long long* count, DeviceImage& image) {
   WT_CUDA(cudaGetDevice(&image.device), kFinish);
   float* rgba = image.rgba.get();
-  if (rgba == nullptr) {
-    const size_t bytes = pixels * 4 * sizeof(float);
-    void* p = nullptr;
-    check_allocation(static_cast<int>(cudaMalloc(&p, bytes)), bytes, kFinish);
-    // Freed where the last owner lets go (a DLPack consumer's, maybe); an error there
-    // surfaces at the next call, as DeviceBuffer's does.
-    image.rgba = std::shared_ptr<float>(static_cast<float*>(p), [](float* q) { cudaFree(q); });
-    rgba = image.rgba.get();
-  } else {
-    // Page-locked host memory as the device addresses it (the same address where
-    // addressing is unified, as on every 64-bit system).
-    cudaPointerAttributes at{};
-    WT_CUDA(cudaPointerGetAttributes(&at, rgba), kFinish);
-    if (at.type == cudaMemoryTypeHost) {
-      void* on_device = nullptr;
-      WT_CUDA(cudaHostGetDevicePointer(&on_device, rgba, 0), kFinish);
-      rgba = static_cast<float*>(on_device);
-    }
+  if (rgba == nullptr && pixels > 0) throw std::logic_error("finish_image: no memory for the image");
+  // Page-locked host memory as the device addresses it (the same address where
+  // addressing is unified, as on every 64-bit system).
+  cudaPointerAttributes at{};
+  WT_CUDA(cudaPointerGetAttributes(&at, rgba), kFinish);
+  if (at.type == cudaMemoryTypeHost) {
+    void* on_device = nullptr;
+    WT_CUDA(cudaHostGetDevicePointer(&on_device, rgba, 0), kFinish);
+    rgba = static_cast<float*>(on_device);
   }
-  DeviceBuffer<unsigned long long> count(1, kFinish);
-  count.zero(kFinish);
+  WT_CUDA(cudaMemsetAsync(count, 0, sizeof(unsigned long long)), kFinish);
   if (pixels > 0) {
     const float inv = 1.0f / static_cast<float>(samples);  // take_mean's factor
     finish_pixels<<<static_cast<unsigned>((pixels + kBlock - 1) / kBlock), kBlock>>>(
-        film, pixels, inv, reinterpret_cast<float4*>(rgba), count.get());
+        film, pixels, inv, reinterpret_cast<float4*>(rgba), count);
     WT_CUDA_LAUNCHED("finish_pixels", kFinish);
   }
   // The count comes back after the kernel: the image is then written, wherever it lies.
   unsigned long long nonfinite = 0;
-  WT_CUDA(cudaMemcpy(&nonfinite, count.get(), sizeof(nonfinite), cudaMemcpyDeviceToHost), kFinish);
+  WT_CUDA(cudaMemcpy(&nonfinite, count, sizeof(nonfinite), cudaMemcpyDeviceToHost), kFinish);
   image.nonfinite_pixels = nonfinite;
 }
 
-struct PinnedImages::Pool {
+struct ImageBlocks::Pool {
   std::mutex mutex;
+  Memory memory = Memory::PageLocked;
+  int device = 0;  // a device block's
   size_t keep = 0;
   int64_t allocations = 0;
   std::vector<std::pair<size_t, float*>> free;  // (floats, block), the last let go last
+
+  void release(float* block) const {
+    // As DeviceBuffer's: an error here surfaces at the next call.
+    if (memory == Memory::PageLocked) {
+      cudaFreeHost(block);
+    } else {
+      cudaFree(block);
+    }
+  }
   ~Pool() {
-    for (const auto& block : free) cudaFreeHost(block.second);
+    for (const auto& block : free) release(block.second);
   }
 };
 
-PinnedImages::PinnedImages(size_t keep) : pool_(std::make_shared<Pool>()) { pool_->keep = keep; }
+ImageBlocks::ImageBlocks(Memory memory, size_t keep) : pool_(std::make_shared<Pool>()) {
+  pool_->memory = memory;
+  pool_->keep = keep;
+  if (memory == Memory::Device) WT_CUDA(cudaGetDevice(&pool_->device), kHandOff);
+}
 
-std::shared_ptr<float> PinnedImages::take(size_t floats) {
+std::shared_ptr<float> ImageBlocks::take(size_t floats) {
   float* block = nullptr;
   {
     std::lock_guard<std::mutex> lock(pool_->mutex);
@@ -101,10 +106,23 @@ std::shared_ptr<float> PinnedImages::take(size_t floats) {
       }
     }
   }
+  const bool on_device = pool_->memory == Memory::Device;
+  if (block != nullptr && on_device) {
+    // What a consumer queued before letting the block go is done before it is written
+    // again (as freeing it would have waited for).
+    WT_CUDA(cudaSetDevice(pool_->device), kHandOff);
+    WT_CUDA(cudaDeviceSynchronize(), kHandOff);
+  }
   if (block == nullptr) {
     void* p = nullptr;
-    // Mapped (the device writes it: finish_image) and usable from every device.
-    WT_CUDA(cudaHostAlloc(&p, floats * sizeof(float), cudaHostAllocMapped | cudaHostAllocPortable), kHandOff);
+    const size_t bytes = floats * sizeof(float);
+    if (on_device) {
+      WT_CUDA(cudaSetDevice(pool_->device), kHandOff);
+      check_allocation(static_cast<int>(cudaMalloc(&p, bytes)), bytes, kHandOff);
+    } else {
+      // Mapped (the device writes it: finish_image) and usable from every device.
+      WT_CUDA(cudaHostAlloc(&p, bytes, cudaHostAllocMapped | cudaHostAllocPortable), kHandOff);
+    }
     block = static_cast<float*>(p);
     std::lock_guard<std::mutex> lock(pool_->mutex);
     ++pool_->allocations;
@@ -115,13 +133,13 @@ std::shared_ptr<float> PinnedImages::take(size_t floats) {
     std::lock_guard<std::mutex> lock(pool->mutex);
     pool->free.emplace_back(floats, p);
     if (pool->free.size() > pool->keep) {
-      cudaFreeHost(pool->free.front().second);  // the block let go longest ago
+      pool->release(pool->free.front().second);  // the block let go longest ago
       pool->free.erase(pool->free.begin());
     }
   });
 }
 
-int64_t PinnedImages::allocations() const {
+int64_t ImageBlocks::allocations() const {
   std::lock_guard<std::mutex> lock(pool_->mutex);
   return pool_->allocations;
 }

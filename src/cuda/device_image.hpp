@@ -24,29 +24,38 @@ struct DeviceImage {
 };
 
 // Memory for the `floats` values of a DeviceImage, which the device writes: page-locked
-// host memory (PinnedImages) for an image wanted on the host.
+// host memory (ImageBlocks::Memory::PageLocked) for an image wanted on the host.
 using ImageMemory = std::function<std::shared_ptr<float>(size_t floats)>;
 
 // The film's sums of `samples` samples per pixel (3 floats a pixel, on the current
 // device) as the image of their means: each sum times 1 / samples in single
 // precision, as take_mean (dispatch/renderer.hpp) makes them on the host, so that
 // the two agree bit for bit; and a pixel is counted as count_nonfinite_pixels
-// (app/job.hpp) counts it. Written into `image.rgba` where the caller gave memory
-// there (pixels x 4 floats): device memory, or page-locked host memory (PinnedImages),
-// which the kernel writes across the bus, so that an image wanted on the host
-// crosses once with no copy of its own; else into device memory it allocates.
-void finish_image(const float* film, size_t pixels, int32_t samples, DeviceImage& image);
+// (app/job.hpp) counts it. Written into `image.rgba` (pixels x 4 floats): device
+// memory, or mapped page-locked host memory, which the kernel writes across the bus,
+// so that an image wanted on the host crosses once with no copy of its own.
+// `count`: one value of the current device's memory for the count, which the caller
+// keeps (a buffer made and freed per image costs a free that waits for the device).
+void finish_image(const float* film, size_t pixels, int32_t samples, unsigned long long* count, DeviceImage& image);
 
-// Page-locked host memory for images brought back from a device, which the device
-// writes at full speed. Allocating it costs milliseconds (a share of a short render),
-// so a block whose last owner lets go is kept for the next image of its size: the
-// `keep` blocks let go last are kept, older ones freed.
-class PinnedImages {
+// Memory for images, kept from one image to the next. Making a block costs a share of
+// a short render (page-locked host memory, milliseconds; device memory, an allocation
+// and, when it is freed, a wait for the device), so a block whose last owner lets go
+// is kept for the next image of its size: the `keep` blocks let go last are kept,
+// older ones freed. The blocks outlive the ImageBlocks that made them.
+class ImageBlocks {
  public:
-  explicit PinnedImages(size_t keep = 2);
-  // Memory for `floats` values: a kept block of that size, or a new one.
+  enum class Memory {
+    PageLocked,  // mapped page-locked host memory, usable from every device
+    Device,      // memory of the device current when the ImageBlocks is made
+  };
+  explicit ImageBlocks(Memory memory, size_t keep = 2);
+  // Memory for `floats` values: a kept block of that size, or a new one. A kept
+  // device block is handed out once the device has done the work queued so far: a
+  // consumer that let it go (torch, through DLPack) may have queued work that reads
+  // it, on a stream of its own.
   std::shared_ptr<float> take(size_t floats);
-  // The blocks allocated so far (kept ones reused are not counted again).
+  // The blocks made so far (kept ones handed out again are not counted again).
   int64_t allocations() const;
 
  private:
