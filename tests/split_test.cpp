@@ -403,7 +403,9 @@ TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
       ASSERT_TRUE(renders_to_device(o));
       RenderResult on = render_to_device(quick(), o, image);
       // With the image before let go, the kept copy writes into its block again.
-      if (last_block != nullptr) EXPECT_EQ(image.rgba.get(), last_block) << what;
+      if (last_block != nullptr) {
+        EXPECT_EQ(image.rgba.get(), last_block) << what;
+      }
       last_block = image.rgba.get();
       EXPECT_TRUE(on.rgb.empty()) << what;
       EXPECT_EQ(on.radiance, Radiance::MeanOfSamples) << what;
