@@ -402,6 +402,7 @@ TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
       cuda::DeviceImage image;
       ASSERT_TRUE(renders_to_device(o));
       RenderResult on = render_to_device(quick(), o, image);
+      image.wait();
       // With the image before let go, the kept copy writes into its block again.
       if (last_block != nullptr) {
         EXPECT_EQ(image.rgba.get(), last_block) << what;
@@ -460,6 +461,9 @@ TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   on_host.rgba = host_blocks.take(pixels * 4);
   const float* block = on_host.rgba.get();
   cuda::finish_image(film, pixels, host.samples, count.get(), on_host);
+  on_device.wait();
+  on_host.wait();
+  EXPECT_FALSE(on_host.writing);
   cuda::free_on_device(film);
   EXPECT_EQ(on_host.rgba.get(), block);  // written where it was given
   cuda::DeviceImage none;
@@ -501,7 +505,7 @@ TEST(ImageOnDevice, BlocksServeTheNextImageOfTheirSize) {
       const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);
       EXPECT_NE(a.get(), b.get());
       EXPECT_EQ(blocks.allocations(), 2);
-      first = b.get();
+      first = a.get();  // let go last (b goes first)
     }
     {
       const std::shared_ptr<float> a = blocks.take(1000), b = blocks.take(1000);

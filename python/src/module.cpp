@@ -233,8 +233,14 @@ nb::tuple render(const PyScene& scene, const nb::object& progress, const std::st
   const wt::app::JobOutcome& out = done.outcome;
   const wt::RenderParams& p = out.params;
   const size_t h = p.height, w = p.width;
-  const std::string stats = scene.session->stats(job, out).dump();
+  // The stats as Python's json reads them, while an image finished on the device
+  // may still be crossing the bus (cuda/device_image.hpp); then the wait for it.
+  const nb::object stats = nb::module_::import_("json").attr("loads")(scene.session->stats(job, out).dump());
   if (done.image.rgba) {
+    {
+      nb::gil_scoped_release released;
+      done.image.wait();
+    }
     return nb::make_tuple(array_of(std::move(done.image.rgba), h, w, 4, device == "cpu" ? -1 : done.image.device),
                           stats, nb::dict(), nb::none());
   }
@@ -316,7 +322,7 @@ NB_MODULE(_wavetrace, m) {
       "A scene in the JSON format's structure; relative paths are read from source's folder.");
   m.def("render", &render, nb::arg("scene"), nb::arg("progress") = nb::none(), nb::arg("device") = "cpu",
         nb::arg("kwargs"),
-        "Renders the scene; returns (the (H, W, 4) float32 image, the stats as JSON text, the AOVs by name, "
+        "Renders the scene; returns (the (H, W, 4) float32 image, the stats as a dict (--stats's JSON), the AOVs by name, "
         "the noisy image of a denoised render or None), the arrays in host memory (device 'cpu') or on the "
         "render's CUDA device ('cuda').");
   m.def("kernels", [](const std::string& backend) { return wt::kernel_names(wt::app::parse_backend(backend)); },

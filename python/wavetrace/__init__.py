@@ -15,7 +15,6 @@ call and the stage.
 
 from __future__ import annotations
 
-import json as _json
 import os as _os
 from typing import Any, Callable, Optional, Union
 
@@ -106,7 +105,6 @@ def render(scene: Scene, progress: Optional[Callable[[float], None]] = None, dev
     scene stays usable.
     """
     array, stats, aovs, noisy = _wavetrace.render(scene, progress, device, **settings)
-    stats = _json.loads(stats)
     if device == "cuda":
         shape = (stats["settings"]["height"], stats["settings"]["width"], 4)
         return CudaImage(array, shape, stats, dict(aovs),

@@ -27,7 +27,9 @@ struct SessionRender {
   int cuda_device = 0;          // the CUDA device it ran on (the first of several); 0 on the CPU
   // A render on one CUDA device with no AOV and no denoiser: its image, finished on
   // the device (cuda/device_image.hpp), and the outcome's result.rgb is empty. Null
-  // rgba otherwise.
+  // rgba otherwise. Its writing may still be under way when render() returns (the
+  // outcome, its count of non-finite pixels and its job_seconds are whole): wait()
+  // before reading it.
   cuda::DeviceImage image;
 };
 

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "cuda/event.hpp"
 #include "device/device.hpp"
 #include "device/kernel_bodies.hpp"
 
@@ -20,26 +21,48 @@ constexpr const char* kFinish = "image finish";
 constexpr const char* kHandOff = "image hand-off";
 constexpr unsigned kBlock = 256;
 
-// Thread per pixel: its mean as RGBA, and the block's count of non-finite pixels
-// added to `nonfinite`.
+// The mean of pixel i's film sums (times `inv`, take_mean's factor).
+__device__ inline float3 pixel_mean(const float* film, size_t i, float inv) {
+  return make_float3(film[3 * i] * inv, film[3 * i + 1] * inv, film[3 * i + 2] * inv);
+}
+
+// Thread per pixel: the block's count of pixels whose mean is not finite, added to
+// `nonfinite`.
 __global__ void __launch_bounds__(kBlock)
-    finish_pixels(const float* film, size_t pixels, float inv, float4* rgba, unsigned long long* nonfinite) {
+    count_nonfinite(const float* film, size_t pixels, float inv, unsigned long long* nonfinite) {
 #if WT_KERNEL_BODIES
   using Reduce = cub::BlockReduce<unsigned, kBlock>;
   __shared__ typename Reduce::TempStorage temp;
   const size_t i = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   unsigned bad = 0;
   if (i < pixels) {
-    const float r = film[3 * i] * inv, g = film[3 * i + 1] * inv, b = film[3 * i + 2] * inv;
-    rgba[i] = make_float4(r, g, b, 1.0f);
-    bad = !(isfinite(r) && isfinite(g) && isfinite(b));
+    const float3 m = pixel_mean(film, i, inv);
+    bad = !(isfinite(m.x) && isfinite(m.y) && isfinite(m.z));
   }
   const unsigned block_bad = Reduce(temp).Sum(bad);
   if (threadIdx.x == 0 && block_bad != 0) atomicAdd(nonfinite, static_cast<unsigned long long>(block_bad));
 #endif
 }
 
+// Thread per pixel: its mean as RGBA.
+__global__ void __launch_bounds__(kBlock) write_means(const float* film, size_t pixels, float inv, float4* rgba) {
+#if WT_KERNEL_BODIES
+  const size_t i = static_cast<size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < pixels) {
+    const float3 m = pixel_mean(film, i, inv);
+    rgba[i] = make_float4(m.x, m.y, m.z, 1.0f);
+  }
+#endif
+}
+
 }  // namespace
+
+struct ImageWriting {
+  Event done;
+  // An image let go unread is still written before its memory goes (freed, or back
+  // to its pool to be written again); an error here surfaces at the next call.
+  ~ImageWriting() { cudaEventSynchronize(done.get()); }
+};
 
 void finish_image(const float* film, size_t pixels, int32_t samples, unsigned long long* count, DeviceImage& image) {
   WT_CUDA(cudaGetDevice(&image.device), kFinish);
@@ -54,17 +77,30 @@ void finish_image(const float* film, size_t pixels, int32_t samples, unsigned lo
     WT_CUDA(cudaHostGetDevicePointer(&on_device, rgba, 0), kFinish);
     rgba = static_cast<float*>(on_device);
   }
+  // The count first, from the film in device memory (a pass that reads it, not the
+  // bus), so that the writing can be left to run.
   WT_CUDA(cudaMemsetAsync(count, 0, sizeof(unsigned long long)), kFinish);
+  const float inv = 1.0f / static_cast<float>(samples);  // take_mean's factor
+  const unsigned blocks = static_cast<unsigned>((pixels + kBlock - 1) / kBlock);
   if (pixels > 0) {
-    const float inv = 1.0f / static_cast<float>(samples);  // take_mean's factor
-    finish_pixels<<<static_cast<unsigned>((pixels + kBlock - 1) / kBlock), kBlock>>>(
-        film, pixels, inv, reinterpret_cast<float4*>(rgba), count);
-    WT_CUDA_LAUNCHED("finish_pixels", kFinish);
+    count_nonfinite<<<blocks, kBlock>>>(film, pixels, inv, count);
+    WT_CUDA_LAUNCHED("count_nonfinite", kFinish);
   }
-  // The count comes back after the kernel: the image is then written, wherever it lies.
   unsigned long long nonfinite = 0;
   WT_CUDA(cudaMemcpy(&nonfinite, count, sizeof(nonfinite), cudaMemcpyDeviceToHost), kFinish);
   image.nonfinite_pixels = nonfinite;
+  if (pixels > 0) {
+    write_means<<<blocks, kBlock>>>(film, pixels, inv, reinterpret_cast<float4*>(rgba));
+    WT_CUDA_LAUNCHED("write_means", kFinish);
+    image.writing = std::make_shared<ImageWriting>();
+    image.writing->done.record(kFinish);
+  }
+}
+
+void DeviceImage::wait() {
+  if (!writing) return;
+  writing->done.synchronize(kHandOff);
+  writing.reset();
 }
 
 struct ImageBlocks::Pool {
