@@ -11,6 +11,8 @@ For each kernel, the same render (scene, size, samples, seed, backend):
   `runs` timed calls of wavetrace.render: each call's wall clock in Python, and its
   stats' `seconds`; the image returned as a numpy array (device "cpu": brought back
   to the host once) and, on the CUDA backend, left on the device (device "cuda").
+  Each command run is followed by a call for each image device, so that drift from
+  one batch of renders to the next touches both.
 
 The overhead is the module's call against the command's render: median call wall
 clock over median command `seconds`, less 1; and, within each call, its wall clock
@@ -40,37 +42,46 @@ from pathlib import Path
 import wavetrace as wt
 
 
-def command_runs(args, kernel, tmp):
-    out = []
-    for i in range(args.runs):
-        stats = Path(tmp) / ("cli-%s-%d.json" % (kernel, i))
-        cmd = [args.bin, "render", args.scene, "-o", str(Path(tmp) / "cli.exr"), "--width", str(args.width),
-               "--height", str(args.height), "--spp", str(args.spp), "--seed", "1", "--backend", args.backend,
-               "--kernel", kernel, "--stats", str(stats), "-q"]
-        t0 = time.perf_counter()
-        subprocess.run(cmd, check=True)
-        wall = time.perf_counter() - t0
-        s = json.loads(stats.read_text())
-        out.append({"seconds": s["seconds"], "job_seconds": s["job_seconds"], "process_seconds": wall})
+def command_run(args, kernel, tmp, i):
+    stats = Path(tmp) / ("cli-%s-%d.json" % (kernel, i))
+    cmd = [args.bin, "render", args.scene, "-o", str(Path(tmp) / "cli.exr"), "--width", str(args.width),
+           "--height", str(args.height), "--spp", str(args.spp), "--seed", "1", "--backend", args.backend,
+           "--kernel", kernel, "--stats", str(stats), "-q"]
+    t0 = time.perf_counter()
+    subprocess.run(cmd, check=True)
+    wall = time.perf_counter() - t0
+    s = json.loads(stats.read_text())
+    return {"seconds": s["seconds"], "job_seconds": s["job_seconds"], "process_seconds": wall}
+
+
+def module_run(scene, settings, device):
+    t0 = time.perf_counter()
+    img = wt.render(scene, device=device, **settings)
+    wall = time.perf_counter() - t0
+    out = {"call_seconds": wall, "seconds": img.stats["seconds"], "job_seconds": img.stats["job_seconds"],
+           "upload_seconds": img.stats["upload_seconds"]}
+    # The image is let go outside the call, and timed on its own: a loop that
+    # rebinds `img = wavetrace.render(...)` lets it go as the name is rebound.
+    t0 = time.perf_counter()
+    del img
+    out["let_go_seconds"] = time.perf_counter() - t0
     return out
 
 
-def module_runs(args, kernel, scene, device):
+def runs(args, kernel, scene, devices, tmp):
+    """The command's runs and the module's, interleaved (a command, then a call for
+    each image device, `runs` times), so that whatever drifts from one batch of
+    renders to the next (the same command's render moves by 1 to 2% between
+    batches on the H100) touches both alike."""
     settings = dict(width=args.width, height=args.height, spp=args.spp, seed=1, backend=args.backend, kernel=kernel)
-    img = wt.render(scene, device=device, **settings)  # the upload (CUDA), and the first render's set-up
-    out = []
-    for _ in range(args.runs):
-        # The image before is let go outside the call, and timed on its own: a loop
-        # that rebinds `img = wavetrace.render(...)` frees it as the name is rebound.
-        t0 = time.perf_counter()
-        del img
-        let_go = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        img = wt.render(scene, device=device, **settings)
-        wall = time.perf_counter() - t0
-        out.append({"call_seconds": wall, "seconds": img.stats["seconds"], "job_seconds": img.stats["job_seconds"],
-                    "upload_seconds": img.stats["upload_seconds"], "let_go_seconds": let_go})
-    return out
+    for device in devices:
+        wt.render(scene, device=device, **settings)  # the upload (CUDA), and the first render's set-up
+    cli, mod = [], {d: [] for d in devices}
+    for i in range(args.runs):
+        cli.append(command_run(args, kernel, tmp, i))
+        for device in devices:
+            mod[device].append(module_run(scene, settings, device))
+    return cli, mod
 
 
 def main():
@@ -91,10 +102,10 @@ def main():
     devices = ["cpu", "cuda"] if args.backend == "cuda" else ["cpu"]
     with tempfile.TemporaryDirectory() as tmp:
         for kernel in kernels:
-            cli = command_runs(args, kernel, tmp)
+            cli, by_device = runs(args, kernel, scene, devices, tmp)
             cli_render = statistics.median(r["seconds"] for r in cli)
             for device in devices:
-                mod = module_runs(args, kernel, scene, device)
+                mod = by_device[device]
                 call = statistics.median(r["call_seconds"] for r in mod)
                 added = statistics.median(r["call_seconds"] - r["seconds"] for r in mod)
                 render = statistics.median(r["seconds"] for r in mod)
