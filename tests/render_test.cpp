@@ -152,6 +152,40 @@ TEST_P(EveryKernel, AStoppedRenderResumedFromItsFilmEqualsTheWholeRender) {
   expect_same_image(a.rgb, resumed.rgb);
 }
 
+// Told its progress, a render tells shares that rise to 1 and rays that rise to its
+// own count (the CUDA megakernel reads those of the passes before each pass without
+// holding that pass back), and renders the image and the rays it renders untold.
+TEST_P(EveryKernel, ProgressRisesToTheWholeAndLeavesTheImageAsItIs) {
+  const Scene scene = load_scene(test::repo_path("scenes/quick.json"));
+  const RenderOptions quiet = options_for(GetParam().backend, GetParam().kernel, 64, 36, 20, 8, 3, 11);
+  const RenderResult a = render(scene, quiet);
+  RenderOptions told = quiet;
+  std::vector<std::pair<double, uint64_t>> calls;
+  told.progress = [&](double done, uint64_t rays, double) { calls.emplace_back(done, rays); };
+  const RenderResult b = render(scene, told);
+  // Every kernel tells as it goes but the CPU megakernel, which tells at most every
+  // 250 ms: a render this short tells only its end there.
+  const bool as_it_goes = GetParam().backend == Backend::Cuda || is_wavefront(GetParam().kernel);
+  ASSERT_GE(calls.size(), as_it_goes ? 2u : 1u);
+  for (size_t i = 0; i < calls.size(); ++i) {
+    EXPECT_GE(calls[i].first, 0.0) << i;
+    EXPECT_LE(calls[i].first, 1.0) << i;
+    EXPECT_LE(calls[i].second, b.rays) << i;
+    if (i > 0) {
+      EXPECT_GE(calls[i].first, calls[i - 1].first) << i;
+      EXPECT_GE(calls[i].second, calls[i - 1].second) << i;
+    }
+  }
+  if (as_it_goes) {
+    EXPECT_GT(calls.front().second, 0u);
+    EXPECT_LT(calls.front().second, b.rays);
+  }
+  EXPECT_EQ(calls.back().first, 1.0);
+  EXPECT_EQ(calls.back().second, b.rays);
+  EXPECT_EQ(a.rays, b.rays);
+  expect_same_image(a.rgb, b.rgb);
+}
+
 TEST(SamplePasses, AreEvenAndCoverTheSamplesOnce) {
   const auto passes = plan_passes(100, 3, 25, 4, 0, kMaxPathsPerPass);
   ASSERT_EQ(passes.size(), 4u);

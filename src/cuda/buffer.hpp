@@ -82,6 +82,7 @@ class PinnedBuffer {
     if (size_) WT_CUDA(cudaMemcpy(ptr_, device, size_ * sizeof(T), cudaMemcpyDeviceToHost), stage);
   }
   const T* get() const { return ptr_; }
+  T* get() { return ptr_; }
   size_t size() const { return size_; }
 
  private:

@@ -32,9 +32,12 @@ std::string mib(size_t bytes) { return std::to_string((bytes + (1 << 20) - 1) >>
 // The megakernel renders in passes of samples (at least ten, so that progress can
 // be shown between them); the next pass is queued before the host waits on the
 // last one, unless after_pass must see each pass's film. `rays`: two counters on the
-// device (path rays, shadow rays), which the caller keeps from one render to the next.
+// device (path rays, shadow rays), and `rays_told`, one value of page-locked host
+// memory that progress reads them into, which the caller keeps from one render to
+// the next.
 RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const SceneView& view,
-                               const RenderOptions& options, int sm_count, unsigned long long* rays) {
+                               const RenderOptions& options, int sm_count, unsigned long long* rays,
+                               unsigned long long* rays_told) {
   const RenderParams& rp = options.params;
   const bool constant = options.kernel == Kernel::MegakernelConstant;
   if (constant) {
@@ -94,8 +97,18 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     EventTimer timer("megakernel");
     timer.start();
     std::vector<Event> pass_done(passes.size());
+    Event told;
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
+      // The rays of the passes before, copied to the host ahead of this pass: the
+      // host waits for that copy, while this pass stays queued behind it (a copy that
+      // waited for this pass left the device idle between passes).
+      const bool tell = last && options.progress && p > 0;
+      if (tell) {
+        WT_CUDA(cudaMemcpyAsync(rays_told, rays, sizeof(unsigned long long), cudaMemcpyDeviceToHost, nullptr),
+                "megakernel");
+        told.record("megakernel");
+      }
       if (batch <= 1) {
         launch(pass.first, pass.count, work(film, nullptr));
       } else {
@@ -116,11 +129,9 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
           break;
         }
       }
-      if (last && options.progress && p > 0) {
-        pass_done[p - 1].synchronize("megakernel");
-        unsigned long long so_far = 0;
-        WT_CUDA(cudaMemcpy(&so_far, rays, sizeof(so_far), cudaMemcpyDeviceToHost), "megakernel");
-        options.progress(static_cast<double>(p) / passes.size(), so_far, timer.elapsed_host());
+      if (tell) {
+        told.synchronize("megakernel");
+        options.progress(static_cast<double>(p) / passes.size(), *rays_told, timer.elapsed_host());
       }
     }
     return timer.stop();
@@ -169,7 +180,8 @@ namespace {
 // (Device memory made and freed per render costs a free that waits for the device.)
 struct DeviceCopy {
   DeviceCopy(const Scene& scene, const DeviceInfo& read_before)
-      : info(read_before), rays(2, kStage), nonfinite(1, kStage), images(ImageBlocks::Memory::Device) {
+      : info(read_before), rays(2, kStage), rays_told(1, kStage), nonfinite(1, kStage),
+        images(ImageBlocks::Memory::Device) {
     const auto t0 = std::chrono::steady_clock::now();
     ds = std::make_unique<DeviceScene>(scene, scene.render.width, scene.render.height);
     WT_CUDA(cudaDeviceSynchronize(), "scene upload");
@@ -180,6 +192,7 @@ struct DeviceCopy {
   double upload_seconds = 0;
   WaveRenderer waves;
   DeviceBuffer<unsigned long long> rays;       // the megakernels' path and shadow rays
+  PinnedBuffer<unsigned long long> rays_told;  // and their path rays so far, as progress reads them
   DeviceBuffer<float> film;                    // render_image's, kept for the next render of its size
   DeviceBuffer<unsigned long long> nonfinite;  // render_image's count of non-finite pixels
   ImageBlocks images;                          // render_image's images wanted in device memory
@@ -330,7 +343,8 @@ class Uploaded {
     DeviceCopy& copy = lease_.copy();
     RenderResult out = is_wavefront(options.kernel)
                            ? copy.waves.render(view_, scene_.sort_key_bits(), options, wave_)
-                           : render_megakernel(scene_, *copy.ds, view_, options, copy.info.sm_count, copy.rays.get());
+                           : render_megakernel(scene_, *copy.ds, view_, options, copy.info.sm_count, copy.rays.get(),
+                                               copy.rays_told.get());
     out.upload_seconds = lease_.upload_seconds();
     out.device = copy.info.name;
     return out;
