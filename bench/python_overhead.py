@@ -12,14 +12,16 @@ For each kernel, the same render (scene, size, samples, seed, backend):
   stats' `seconds`; the image returned as a numpy array (device "cpu": brought back
   to the host once) and, on the CUDA backend, left on the device (device "cuda").
   Each command run is followed by a call for each image device, so that drift from
-  one batch of renders to the next touches both.
+  one batch of renders to the next touches both; then `runs` calls in a row for
+  each, as a sweep makes them.
 
 The overhead is the module's call against the command's render: median call wall
 clock over median command `seconds`, less 1; and, within each call, its wall clock
 less its own render `seconds` (what the module adds: on CUDA, finishing the image
 on the device and handing it over or writing it into host memory; on the CPU, the
 mean and the RGBA array; the settings, the lease of the kept scene, the stats), as a
-share of the render's `seconds`. What a call adds is split in two: within the
+share of the render's `seconds`: for the calls that each follow a command, and for
+the calls in a row. What a call adds is split in two: within the
 render session (its stats' `job_seconds` less `seconds`: the settings, the lease,
 the image finished and handed over) and around it (the call's wall clock less
 `job_seconds`: Python, the keywords, the stats read back, the array). The image
@@ -81,7 +83,10 @@ def runs(args, kernel, scene, devices, tmp):
         cli.append(command_run(args, kernel, tmp, i))
         for device in devices:
             mod[device].append(module_run(scene, settings, device))
-    return cli, mod
+    # Then calls one after another, as a sweep makes them: a call that follows a
+    # command finds the machine's caches and the GPU as another process left them.
+    in_a_row = {d: [module_run(scene, settings, d) for _ in range(args.runs)] for d in devices}
+    return cli, mod, in_a_row
 
 
 def main():
@@ -102,14 +107,17 @@ def main():
     devices = ["cpu", "cuda"] if args.backend == "cuda" else ["cpu"]
     with tempfile.TemporaryDirectory() as tmp:
         for kernel in kernels:
-            cli, by_device = runs(args, kernel, scene, devices, tmp)
+            cli, by_device, in_a_row = runs(args, kernel, scene, devices, tmp)
             cli_render = statistics.median(r["seconds"] for r in cli)
             for device in devices:
                 mod = by_device[device]
+                row = in_a_row[device]
+                row_added = statistics.median(r["call_seconds"] - r["seconds"] for r in row)
+                row_render = statistics.median(r["seconds"] for r in row)
                 call = statistics.median(r["call_seconds"] for r in mod)
                 added = statistics.median(r["call_seconds"] - r["seconds"] for r in mod)
                 render = statistics.median(r["seconds"] for r in mod)
-                rows.append({"kernel": kernel, "device": device, "command": cli, "module": mod,
+                rows.append({"kernel": kernel, "device": device, "command": cli, "module": mod, "in_a_row": row,
                              "command_render_seconds": cli_render,
                              "command_job_seconds": statistics.median(r["job_seconds"] for r in cli),
                              "command_process_seconds": statistics.median(r["process_seconds"] for r in cli),
@@ -119,6 +127,10 @@ def main():
                              "added_in_session_seconds": statistics.median(r["job_seconds"] - r["seconds"] for r in mod),
                              "added_around_session_seconds": statistics.median(r["call_seconds"] - r["job_seconds"]
                                                                                for r in mod),
+                             "in_a_row_added_seconds": row_added,
+                             "in_a_row_added_share": row_added / row_render,
+                             "in_a_row_in_session_seconds": statistics.median(r["job_seconds"] - r["seconds"]
+                                                                              for r in row),
                              "image_let_go_seconds": statistics.median(r["let_go_seconds"] for r in mod),
                              "overhead_vs_command": call / cli_render - 1,
                              "added_share": added / render})
@@ -126,16 +138,18 @@ def main():
               "spp": args.spp, "runs": args.runs, "uploads": scene.uploads,
               "pinned_blocks": wt._wavetrace.pinned_allocations(), "rows": rows}
     print("| kernel | image | command render s | command job s | module call s | module render s | "
-          "added by the module (of its render) | in the session | around it | letting the image go | "
-          "call vs command render |")
-    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+          "call vs command render | added, each call after a command (of its render) | in the session | "
+          "around it | letting the image go | added, calls in a row | in the session |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for r in rows:
-        print("| %s | %s | %.4f | %.3f | %.4f | %.4f | %.2f ms (%.2f%%) | %.2f ms | %.2f ms | %.2f ms | %+.2f%% |" % (
-            r["kernel"], "numpy" if r["device"] == "cpu" else "cuda", r["command_render_seconds"],
-            r["command_job_seconds"], r["module_call_seconds"], r["module_render_seconds"],
-            1e3 * r["module_added_seconds"], 100 * r["added_share"], 1e3 * r["added_in_session_seconds"],
-            1e3 * r["added_around_session_seconds"], 1e3 * r["image_let_go_seconds"],
-            100 * r["overhead_vs_command"]))
+        print("| %s | %s | %.4f | %.3f | %.4f | %.4f | %+.2f%% | %.2f ms (%.2f%%) | %.2f ms | %.2f ms | %.2f ms "
+              "| %.2f ms (%.2f%%) | %.2f ms |" % (
+                  r["kernel"], "numpy" if r["device"] == "cpu" else "cuda", r["command_render_seconds"],
+                  r["command_job_seconds"], r["module_call_seconds"], r["module_render_seconds"],
+                  100 * r["overhead_vs_command"], 1e3 * r["module_added_seconds"], 100 * r["added_share"],
+                  1e3 * r["added_in_session_seconds"], 1e3 * r["added_around_session_seconds"],
+                  1e3 * r["image_let_go_seconds"], 1e3 * r["in_a_row_added_seconds"],
+                  100 * r["in_a_row_added_share"], 1e3 * r["in_a_row_in_session_seconds"]))
     print("scene uploads through the module: %d; page-locked image blocks allocated: %d" % (
         scene.uploads, report["pinned_blocks"]))
     if args.out:
