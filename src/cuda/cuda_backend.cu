@@ -96,8 +96,7 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
     out.paths = 0;
     EventTimer timer("megakernel");
     timer.start();
-    std::vector<Event> pass_done(passes.size());
-    Event told;
+    Event pass_done, told;
     for (size_t p = 0; p < passes.size(); ++p) {
       const SamplePass& pass = passes[p];
       // The rays of the passes before, copied to the host ahead of this pass: the
@@ -119,11 +118,11 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
                                  nullptr);
         }
       }
-      pass_done[p].record("megakernel");
       out.samples = pass.first + pass.count;
       out.paths += pixels * static_cast<uint64_t>(pass.count);
       if (last && options.after_pass) {
-        pass_done[p].synchronize("megakernel");
+        pass_done.record("megakernel");
+        pass_done.synchronize("megakernel");
         if (!options.after_pass(out.samples, [&] { return own_film.download(kStage); })) {
           out.interrupted = p + 1 < passes.size();
           break;

@@ -143,17 +143,16 @@ std::shared_ptr<float> ImageBlocks::take(size_t floats) {
     }
   }
   const bool on_device = pool_->memory == Memory::Device;
+  if (on_device) WT_CUDA(cudaSetDevice(pool_->device), kHandOff);
   if (block != nullptr && on_device) {
     // What a consumer queued before letting the block go is done before it is written
     // again (as freeing it would have waited for).
-    WT_CUDA(cudaSetDevice(pool_->device), kHandOff);
     WT_CUDA(cudaDeviceSynchronize(), kHandOff);
   }
   if (block == nullptr) {
     void* p = nullptr;
     const size_t bytes = floats * sizeof(float);
     if (on_device) {
-      WT_CUDA(cudaSetDevice(pool_->device), kHandOff);
       check_allocation(static_cast<int>(cudaMalloc(&p, bytes)), bytes, kHandOff);
     } else {
       // Mapped (the device writes it: finish_image) and usable from every device.
