@@ -9,7 +9,9 @@
 #include <cub/device/device_select.cuh>
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <type_traits>
 #include <vector>
 
@@ -109,8 +111,20 @@ class Executor {
     return wave_.get();
   }
 
-  // The most temporary storage compact (over `capacity` entries) and sort need.
+  // The most temporary storage compact (over `capacity` entries) and sort need on the
+  // current device: CUB's answer, asked once for each device and capacity (a render
+  // asks for its wave's, and for the sizing's, at every call).
   static size_t temp_bytes(size_t capacity) {
+    int device = 0;
+    WT_CUDA(cudaGetDevice(&device), "compact");
+    static std::mutex mutex;
+    static std::map<std::pair<int, size_t>, size_t> known;
+    const std::pair<int, size_t> key(device, capacity);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      const auto it = known.find(key);
+      if (it != known.end()) return it->second;
+    }
     size_t select = 0, sort = 0;
     const int64_t n = static_cast<int64_t>(capacity);
     WT_CUDA(cub::DeviceSelect::If(nullptr, select, static_cast<const uint32_t*>(nullptr),
@@ -119,7 +133,8 @@ class Executor {
             "compact");
     cub::DoubleBuffer<uint32_t> keys(nullptr, nullptr);
     WT_CUDA(cub::DeviceRadixSort::SortKeys(nullptr, sort, keys, n, 0, 32), "sort");
-    return std::max(select, sort);
+    std::lock_guard<std::mutex> lock(mutex);
+    return known.emplace(key, std::max(select, sort)).first->second;
   }
 
   template <class Item>
