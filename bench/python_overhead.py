@@ -13,7 +13,10 @@ For each kernel, the same render (scene, size, samples, seed, backend):
   to the host once) and, on the CUDA backend, left on the device (device "cuda").
   Each command run is followed by a call for each image device, so that drift from
   one batch of renders to the next touches both; then `runs` calls in a row for
-  each, as a sweep makes them.
+  each, as a sweep makes them. With --settle, each call that follows a command waits
+  that long after the command's process has exited (on the H100 such a call added
+  0.1 to 0.2 ms more than calls in a row; the pause tells whether that is the
+  machine still busy with the process that has gone).
 
 The overhead is the module's call against the command's render: median call wall
 clock over median command `seconds`, less 1; and, within each call, its wall clock
@@ -81,6 +84,10 @@ def runs(args, kernel, scene, devices, tmp):
     cli, mod = [], {d: [] for d in devices}
     for i in range(args.runs):
         cli.append(command_run(args, kernel, tmp, i))
+        # --settle: a pause between the command's exit and the call, for whatever the
+        # machine does after a process has gone (its context torn down, its memory
+        # given back) to be done before the call is timed.
+        time.sleep(args.settle)
         for device in devices:
             mod[device].append(module_run(scene, settings, device))
     # Then calls one after another, as a sweep makes them: a call that follows a
@@ -99,6 +106,8 @@ def main():
     ap.add_argument("--height", type=int, default=1080)
     ap.add_argument("--spp", type=int, default=64)
     ap.add_argument("--runs", type=int, default=5)
+    ap.add_argument("--settle", type=float, default=0.0,
+                    help="seconds to wait after each command before the calls that follow it")
     ap.add_argument("--out", default=None, help="a JSON file of every run and the medians")
     args = ap.parse_args()
     kernels = args.kernels or wt.kernels(args.backend)
@@ -135,7 +144,7 @@ def main():
                              "overhead_vs_command": call / cli_render - 1,
                              "added_share": added / render})
     report = {"scene": args.scene, "backend": args.backend, "width": args.width, "height": args.height,
-              "spp": args.spp, "runs": args.runs, "uploads": scene.uploads,
+              "spp": args.spp, "runs": args.runs, "settle_seconds": args.settle, "uploads": scene.uploads,
               "pinned_blocks": wt._wavetrace.pinned_allocations(), "rows": rows}
     print("| kernel | image | command render s | command job s | module call s | module render s | "
           "call vs command render | added, each call after a command (of its render) | in the session | "
