@@ -437,7 +437,8 @@ TEST(ImageOnDevice, HoldsTheMeansRenderReturns) {
 
 // The finishing kernel over a film of known sums, with a NaN, both infinities and a
 // subnormal among them: its means are take_mean's bit for bit (the NaN a NaN), and it
-// counts the pixels count_nonfinite_pixels counts. The pixels are more than a block.
+// counts the pixels count_nonfinite_pixels counts, after the film's queued work. The
+// pixels are more than a block.
 TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   WT_REQUIRE_CUDA();
   RenderResult host;
@@ -451,23 +452,39 @@ TEST(ImageOnDevice, FinishesAFilmAsTheHostDoes) {
   host.rgb[3 * 501] = 3e38f;   // finite, its mean too
   float* film = cuda::copy_to_device(host.rgb.data(), host.rgb.size(), 0);
   // Into device memory, and into a page-locked block the kernel writes across the
-  // bus; the count's memory, given once, is cleared by each.
-  cuda::DeviceBuffer<unsigned long long> count(1, "test");
+  // bus, by one finisher: its count, kept, is cleared by each.
+  cuda::ImageFinisher finisher;
   cuda::ImageBlocks device_blocks(cuda::ImageBlocks::Memory::Device), host_blocks(cuda::ImageBlocks::Memory::PageLocked);
   cuda::DeviceImage on_device;
   on_device.rgba = device_blocks.take(pixels * 4);
-  cuda::finish_image(film, pixels, host.samples, count.get(), on_device);
+  finisher.finish(film, pixels, host.samples, on_device);
   cuda::DeviceImage on_host;
   on_host.rgba = host_blocks.take(pixels * 4);
   const float* block = on_host.rgba.get();
-  cuda::finish_image(film, pixels, host.samples, count.get(), on_host);
+  finisher.finish(film, pixels, host.samples, on_host);
   on_device.wait();
   on_host.wait();
   EXPECT_FALSE(on_host.writing);
+  // A film as the default stream's queued work leaves it: copied there behind the
+  // clearing of 256 MiB (some 0.1 ms), which the count, on a stream of its own, must
+  // wait for (read at once, the film is zeros: no pixel counted).
+  {
+    cuda::DeviceBuffer<float> slow(size_t(64) << 20, "test"), late(pixels * 3, "test");
+    late.zero("test");
+    ASSERT_EQ(cudaDeviceSynchronize(), cudaSuccess);
+    slow.zero("test");
+    ASSERT_EQ(cudaMemcpyAsync(late.get(), film, pixels * 3 * sizeof(float), cudaMemcpyDeviceToDevice, nullptr),
+              cudaSuccess);
+    cuda::DeviceImage after;
+    after.rgba = device_blocks.take(pixels * 4);
+    finisher.finish(late.get(), pixels, host.samples, after);
+    after.wait();
+    EXPECT_EQ(after.nonfinite_pixels, 3u);
+  }
   cuda::free_on_device(film);
   EXPECT_EQ(on_host.rgba.get(), block);  // written where it was given
   cuda::DeviceImage none;
-  EXPECT_THROW(cuda::finish_image(film, pixels, host.samples, count.get(), none), std::logic_error);
+  EXPECT_THROW(finisher.finish(film, pixels, host.samples, none), std::logic_error);
   std::vector<float> from_device(pixels * 4);
   cuda::copy_to_host(on_device.rgba.get(), from_device.size(), from_device.data());
   take_mean(host);

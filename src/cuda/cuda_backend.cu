@@ -175,11 +175,11 @@ namespace {
 // upload (its free memory, which the wave size is chosen from, so that a kept copy's
 // renders choose what a fresh upload's would) and what its renders set up, kept from
 // one to the next: the wavefront's (pinned counters, the wave's memory), the
-// megakernels' ray counters, and render_image's film, count and image memory.
+// megakernels' ray counters, and render_image's film, image memory and finisher.
 // (Device memory made and freed per render costs a free that waits for the device.)
 struct DeviceCopy {
   DeviceCopy(const Scene& scene, const DeviceInfo& read_before)
-      : info(read_before), rays(2, kStage), rays_told(1, kStage), nonfinite(1, kStage),
+      : info(read_before), rays(2, kStage), rays_told(1, kStage),
         images(ImageBlocks::Memory::Device) {
     const auto t0 = std::chrono::steady_clock::now();
     ds = std::make_unique<DeviceScene>(scene, scene.render.width, scene.render.height);
@@ -193,7 +193,7 @@ struct DeviceCopy {
   DeviceBuffer<unsigned long long> rays;       // the megakernels' path and shadow rays
   PinnedBuffer<unsigned long long> rays_told;  // and their path rays so far, as progress reads them
   DeviceBuffer<float> film;                    // render_image's, kept for the next render of its size
-  DeviceBuffer<unsigned long long> nonfinite;  // render_image's count of non-finite pixels
+  ImageFinisher finisher;                      // render_image's finishing of its images
   ImageBlocks images;                          // render_image's images wanted in device memory
 };
 
@@ -410,7 +410,7 @@ RenderResult render_image(const Scene& scene, const RenderOptions& options, Devi
   film.zero(kStage);
   RenderResult out = uploaded.render(into);
   if (!image.rgba) image.rgba = copy.images.take(pixels * 4);
-  finish_image(film.get(), pixels, out.samples, copy.nonfinite.get(), image);
+  copy.finisher.finish(film.get(), pixels, out.samples, image);
   out.radiance = Radiance::MeanOfSamples;
   if (options.progress) options.progress(1.0, out.rays, out.seconds);
   return out;

@@ -24,7 +24,7 @@ RenderResult render(const Scene& scene, const RenderOptions& options);
 // The same render of a whole film (from sample 0, no adaptive rounds) on that one
 // device, its image finished there (device_image.hpp) instead of brought back: the
 // result's rgb is empty, and `image` holds each pixel's mean: in the memory its rgba
-// names where it names some (finish_image), else in device memory that the scene's
+// names where it names some (ImageFinisher), else in device memory that the scene's
 // copy there keeps for images (ImageBlocks: a block let go serves the next image).
 RenderResult render_image(const Scene& scene, const RenderOptions& options, DeviceImage& image);
 

@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "cuda/buffer.hpp"
 #include "cuda/event.hpp"
 #include "device/device.hpp"
 #include "device/kernel_bodies.hpp"
@@ -64,10 +65,20 @@ struct ImageWriting {
   ~ImageWriting() { cudaEventSynchronize(done.get()); }
 };
 
-void finish_image(const float* film, size_t pixels, int32_t samples, unsigned long long* count, DeviceImage& image) {
+struct ImageFinisher::Kept {
+  DeviceBuffer<unsigned long long> count{1, kFinish};
+  PinnedBuffer<unsigned long long> told{1, kFinish};  // the count, brought back
+  Stream beside{kFinish};
+  Event film_done;  // the default stream's work on the film
+};
+
+ImageFinisher::ImageFinisher() : kept_(std::make_unique<Kept>()) {}
+ImageFinisher::~ImageFinisher() = default;
+
+void ImageFinisher::finish(const float* film, size_t pixels, int32_t samples, DeviceImage& image) {
   WT_CUDA(cudaGetDevice(&image.device), kFinish);
   float* rgba = image.rgba.get();
-  if (rgba == nullptr && pixels > 0) throw std::logic_error("finish_image: no memory for the image");
+  if (rgba == nullptr && pixels > 0) throw std::logic_error("ImageFinisher: no memory for the image");
   // Page-locked host memory as the device addresses it (the same address where
   // addressing is unified, as on every 64-bit system).
   cudaPointerAttributes at{};
@@ -77,24 +88,32 @@ void finish_image(const float* film, size_t pixels, int32_t samples, unsigned lo
     WT_CUDA(cudaHostGetDevicePointer(&on_device, rgba, 0), kFinish);
     rgba = static_cast<float*>(on_device);
   }
-  // The count first, from the film in device memory (a pass that reads it, not the
-  // bus), so that the writing can be left to run.
-  WT_CUDA(cudaMemsetAsync(count, 0, sizeof(unsigned long long)), kFinish);
   const float inv = 1.0f / static_cast<float>(samples);  // take_mean's factor
   const unsigned blocks = static_cast<unsigned>((pixels + kBlock - 1) / kBlock);
+  // The count on its own stream, after the film's work, from the film in device
+  // memory (a pass that reads it, not the bus); queued first and at a higher
+  // priority, its blocks run ahead of the writing's.
+  cudaStream_t beside = kept_->beside.get();
+  kept_->film_done.record(kFinish);
+  kept_->beside.wait_for(kept_->film_done, kFinish);
+  WT_CUDA(cudaMemsetAsync(kept_->count.get(), 0, sizeof(unsigned long long), beside), kFinish);
   if (pixels > 0) {
-    count_nonfinite<<<blocks, kBlock>>>(film, pixels, inv, count);
+    count_nonfinite<<<blocks, kBlock, 0, beside>>>(film, pixels, inv, kept_->count.get());
     WT_CUDA_LAUNCHED("count_nonfinite", kFinish);
   }
-  unsigned long long nonfinite = 0;
-  WT_CUDA(cudaMemcpy(&nonfinite, count, sizeof(nonfinite), cudaMemcpyDeviceToHost), kFinish);
-  image.nonfinite_pixels = nonfinite;
+  WT_CUDA(cudaMemcpyAsync(kept_->told.get(), kept_->count.get(), sizeof(unsigned long long), cudaMemcpyDeviceToHost,
+                          beside),
+          kFinish);
   if (pixels > 0) {
     write_means<<<blocks, kBlock>>>(film, pixels, inv, reinterpret_cast<float4*>(rgba));
     WT_CUDA_LAUNCHED("write_means", kFinish);
     image.writing = std::make_shared<ImageWriting>();
     image.writing->done.record(kFinish);
   }
+  // The count is read before the film can be written again: the caller's next work
+  // on it is queued after this returns.
+  kept_->beside.synchronize(kFinish);
+  image.nonfinite_pixels = *kept_->told.get();
 }
 
 void DeviceImage::wait() {
@@ -155,7 +174,7 @@ std::shared_ptr<float> ImageBlocks::take(size_t floats) {
     if (on_device) {
       check_allocation(static_cast<int>(cudaMalloc(&p, bytes)), bytes, kHandOff);
     } else {
-      // Mapped (the device writes it: finish_image) and usable from every device.
+      // Mapped (the device writes it: ImageFinisher) and usable from every device.
       WT_CUDA(cudaHostAlloc(&p, bytes, cudaHostAllocMapped | cudaHostAllocPortable), kHandOff);
     }
     block = static_cast<float*>(p);

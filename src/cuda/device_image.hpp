@@ -17,7 +17,7 @@ namespace wt::cuda {
 // when the last owner lets go): that device's memory, or page-locked host memory
 // where the caller asked for it (ImageMemory); and how many pixels hold a value that
 // is not finite.
-// The image's memory may still be being written (finish_image): wait() before
+// The image's memory may still be being written (ImageFinisher): wait() before
 // reading it. It is not let go before it is written.
 struct ImageWriting;
 struct DeviceImage {
@@ -43,12 +43,27 @@ using ImageMemory = std::function<std::shared_ptr<float>(size_t floats)>;
 // (app/job.hpp) counts it. Written into `image.rgba` (pixels x 4 floats): device
 // memory, or mapped page-locked host memory, which the kernel writes across the bus,
 // so that an image wanted on the host crosses once with no copy of its own. The
-// count is known when it returns; the writing is queued (image.writing), so that the
-// caller's own work (the stats, the array) goes on while a 1080p image crosses the
-// bus, about 0.6 ms: image.wait() before the image is read.
-// `count`: one value of the current device's memory for the count, which the caller
-// keeps (a buffer made and freed per image costs a free that waits for the device).
-void finish_image(const float* film, size_t pixels, int32_t samples, unsigned long long* count, DeviceImage& image);
+// count is known when finish() returns: it is made on a stream of its own, from the
+// film in device memory, beside the writing, which is queued on the default stream
+// (image.writing), so that neither waits for the other and the caller's own work
+// (the stats, the array) goes on while a 1080p image crosses the bus, about 0.6 ms:
+// image.wait() before the image is read. The film is the default stream's work:
+// finish() orders both after what is queued there.
+// An ImageFinisher is made on the device it finishes images of, and keeps what it
+// needs from one image to the next (the count's memory, its stream and event: each
+// made and freed per image costs the image's caller a share of a short render).
+class ImageFinisher {
+ public:
+  ImageFinisher();
+  ~ImageFinisher();
+  ImageFinisher(const ImageFinisher&) = delete;
+  ImageFinisher& operator=(const ImageFinisher&) = delete;
+  void finish(const float* film, size_t pixels, int32_t samples, DeviceImage& image);
+
+ private:
+  struct Kept;
+  std::unique_ptr<Kept> kept_;
+};
 
 // Memory for images, kept from one image to the next. Making a block costs a share of
 // a short render (page-locked host memory, milliseconds; device memory, an allocation

@@ -1,4 +1,4 @@
-// CUDA events: GPU-side timing, and points the host can wait on.
+// CUDA events (GPU-side timing, and points the host can wait on) and streams.
 #pragma once
 
 #include <cuda_runtime.h>
@@ -29,6 +29,29 @@ class Event {
 
  private:
   cudaEvent_t event_ = nullptr;
+};
+
+// A stream of the current device that runs beside the default stream (non-blocking:
+// work on the default stream neither waits for it nor is waited for by it; events
+// order the two), at the device's highest priority, so that its blocks go ahead of
+// work queued before them on the default stream.
+class Stream {
+ public:
+  explicit Stream(const char* stage) {
+    int least = 0, greatest = 0;
+    WT_CUDA(cudaDeviceGetStreamPriorityRange(&least, &greatest), stage);
+    WT_CUDA(cudaStreamCreateWithPriority(&stream_, cudaStreamNonBlocking, greatest), stage);
+  }
+  ~Stream() { cudaStreamDestroy(stream_); }  // as Event's: errors surface at the next call
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+
+  void wait_for(const Event& event, const char* stage) { WT_CUDA(cudaStreamWaitEvent(stream_, event.get(), 0), stage); }
+  void synchronize(const char* stage) { WT_CUDA(cudaStreamSynchronize(stream_), stage); }
+  cudaStream_t get() const { return stream_; }
+
+ private:
+  cudaStream_t stream_ = nullptr;
 };
 
 // Times a region of GPU work with events; also tracks host time for progress lines.
