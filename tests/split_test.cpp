@@ -19,10 +19,12 @@
 #include "app/job.hpp"
 #include "cuda/buffer.hpp"
 #include "cuda/cuda_backend.hpp"
+#include "cuda/cuda_wavefront.hpp"
 #include "device/device.hpp"
 #include "dispatch/renderer.hpp"
 #include "dispatch/split.hpp"
 #include "errors/errors.hpp"
+#include "queues/path_queue.hpp"
 #include "render_support.hpp"
 #include "test_support.hpp"
 
@@ -381,6 +383,49 @@ TEST(ResidentScenes, OneUploadServesRendersOfAnySettings) {
   EXPECT_EQ(scene_uploads(kept.get()), 2);  // the second worker's copy, kept too
   render(quick(), twice);
   EXPECT_EQ(scene_uploads(kept.get()), 2);
+}
+
+// What a kept copy keeps for its renders (the wave's memory, render_image's film)
+// serves its next render, and is not counted again as memory that render needs: a
+// wave of 60% of the memory left free (device memory taken beforehand, so that the
+// wave is the largest, kMaxWaveSize slots, where the device has room) renders again,
+// and its image too, from one copy (counted against the memory left free beside the
+// kept wave, the second render would be refused). A render that does not fit beside
+// the copy, another upload of the same wave, is still refused with the fit check's
+// message.
+TEST(ResidentScenes, WhatACopyKeepsServesItsNextRender) {
+  WT_REQUIRE_CUDA();
+  ASSERT_EQ(cudaSetDevice(0), cudaSuccess);
+  size_t free_bytes = 0, total = 0;
+  ASSERT_EQ(cudaMemGetInfo(&free_bytes, &total), cudaSuccess);
+  const double per_slot = static_cast<double>(cuda::wavefront_bytes(int64_t(1) << 20)) / (1 << 20);
+  RenderOptions o = quick_options(Backend::Cuda, Kernel::Wavefront, {0});
+  o.wave_size = std::min(static_cast<int64_t>(kMaxWaveSize),
+                         static_cast<int64_t>(0.6 * static_cast<double>(free_bytes) / per_slot));
+  const int64_t pixels = static_cast<int64_t>(o.params.width) * o.params.height;
+  o.params.spp = static_cast<int32_t>((o.wave_size + pixels - 1) / pixels);  // one wave's paths at least
+  o.params.depth = 2;
+  const size_t leave = static_cast<size_t>(static_cast<double>(cuda::wavefront_bytes(o.wave_size)) / 0.6);
+  const cuda::DeviceBuffer<unsigned char> taken(free_bytes - std::min(free_bytes, leave), "test");
+  const std::shared_ptr<ResidentScenes> kept = keep_scene(quick(), Backend::Cuda);
+  o.resident = kept;
+  const RenderResult first = render(quick(), o);
+  const RenderResult again = render(quick(), o);
+  expect_same_image(first, again, false, "again");
+  cuda::DeviceImage image;
+  render_to_device(quick(), o, image);
+  image.wait();
+  render_to_device(quick(), o, image);
+  image.wait();
+  EXPECT_EQ(scene_uploads(kept.get()), 1);
+  RenderOptions beside = o;
+  beside.resident = keep_scene(quick(), Backend::Cuda);
+  try {
+    render(quick(), beside);
+    ADD_FAILURE() << "a second wave of 60% of the free memory was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("of device memory"), std::string::npos) << e.what();
+  }
 }
 
 // A render's image finished on its device (render_to_device: a session's renders that

@@ -224,11 +224,14 @@ namespace {
 // The scene on the current device for one render, checked to fit with the render's
 // state (`state_bytes` of it, given the device as the copy read it): a free copy the
 // options' resident scenes keep there, or a new upload (kept there for the next
-// render where they are given). Given back when the render is done.
+// render where they are given). Given back when the render is done. On a kept copy,
+// `made_on` gives the part of that state the render makes anew, beside what the copy
+// keeps for it (all of it where null).
 class DeviceLease {
  public:
   DeviceLease(const Scene& scene, const RenderOptions& options,
-              const std::function<size_t(const DeviceInfo&)>& state_bytes)
+              const std::function<size_t(const DeviceInfo&)>& state_bytes,
+              const std::function<size_t(const DeviceCopy&)>& made_on = nullptr)
       : resident_(options.resident) {
     if (resident_ && resident_->scene != &scene) {
       throw std::logic_error("cuda: resident copies of another scene");
@@ -240,11 +243,17 @@ class DeviceLease {
       std::vector<ResidentScenes::Slot>& slots = resident_->by_device[device_];
       for (size_t i = 0; i < slots.size() && !copy_; ++i) {
         if (slots[i].held) continue;
-        // The scene is there: only the render's own state must fit beside it (the free
-        // memory read alone: the device's properties are the copy's).
-        size_t free_now = 0, total = 0;
-        WT_CUDA(cudaMemGetInfo(&free_now, &total), "device query");
-        require_device_memory(rp, state_bytes(slots[i].copy->info), free_now, slots[i].copy->info.name);
+        // The scene is there: only the state the render makes anew must fit beside it,
+        // not what the copy keeps for it, which the free memory no longer counts (the
+        // free memory read alone, and only where some is made: the device's properties
+        // are the copy's).
+        const DeviceCopy& kept = *slots[i].copy;
+        const size_t made = made_on ? made_on(kept) : state_bytes(kept.info);
+        if (made > 0) {
+          size_t free_now = 0, total = 0;
+          WT_CUDA(cudaMemGetInfo(&free_now, &total), "device query");
+          require_device_memory(rp, made, free_now, kept.info.name);
+        }
         slots[i].held = true;
         copy_ = slots[i].copy;
         slot_ = i;
@@ -297,14 +306,36 @@ int64_t wave_size_on(const RenderOptions& options, const DeviceInfo& info) {
 
 // The scene on the current device (DeviceLease), and renders of any of the render's
 // samples over it.
+// Of a render's state (render_state_bytes) on a kept copy, the bytes the render makes
+// anew: its wave's memory grows where it must (the old block freed first), and
+// render_image's film (`image`), which the copy keeps, is made again (freed first)
+// where its size changes, so each counts only what it needs beyond what the copy
+// keeps of it; the rest (the render's own film, the megakernels' batches) is made
+// per render.
+size_t state_made_on(const DeviceCopy& copy, const RenderOptions& options, int64_t wave, bool image) {
+  const RenderParams& rp = options.params;
+  const size_t film = static_cast<size_t>(rp.width) * rp.height * 3 * sizeof(float);
+  const size_t wave_need = is_wavefront(options.kernel) ? wavefront_bytes(wave) : 0;
+  const size_t rest = render_state_bytes(rp, options.kernel, wave) - wave_need - (image ? film : 0);
+  auto beyond = [](size_t need, size_t kept) { return need - std::min(need, kept); };
+  return rest + beyond(wave_need, copy.waves.kept_bytes()) +
+         (image ? beyond(film, copy.film.size() * sizeof(float)) : 0);
+}
+
+// `image`: render_image's, whose film the copy keeps, where render's film is the
+// render's own.
 class Uploaded {
  public:
-  Uploaded(const Scene& scene, const RenderOptions& options)
+  Uploaded(const Scene& scene, const RenderOptions& options, bool image = false)
       : scene_(scene),
-        lease_(scene, options,
-               [&options](const DeviceInfo& info) {
-                 return render_state_bytes(options.params, options.kernel, wave_size_on(options, info));
-               }),
+        lease_(
+            scene, options,
+            [&options](const DeviceInfo& info) {
+              return render_state_bytes(options.params, options.kernel, wave_size_on(options, info));
+            },
+            [&options, image](const DeviceCopy& copy) {
+              return state_made_on(copy, options, wave_size_on(options, copy.info), image);
+            }),
         wave_(wave_size_on(options, lease_.copy().info)),
         view_(lease_.copy().ds->view_at(scene, options.params.width, options.params.height)) {}
 
@@ -390,7 +421,7 @@ RenderResult render_image(const Scene& scene, const RenderOptions& options, Devi
     throw std::logic_error("cuda: render_image renders a whole film from sample 0 on one device");
   }
   if (options.devices.size() == 1) WT_CUDA(cudaSetDevice(options.devices[0]), "device selection");
-  const Uploaded uploaded(scene, options);
+  const Uploaded uploaded(scene, options, true);
   const RenderParams& rp = options.params;
   const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
   // The render adds into a film the copy keeps, which it neither clears nor brings

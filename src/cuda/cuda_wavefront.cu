@@ -39,4 +39,6 @@ RenderResult WaveRenderer::render(const SceneView& scene, int key_bits, const Re
   return wt::render_wavefront(kept_->ex, scene, key_bits, options, wave_size);
 }
 
+size_t WaveRenderer::kept_bytes() const { return kept_ ? kept_->ex.wave_bytes() : 0; }
+
 }  // namespace wt::cuda

@@ -26,6 +26,8 @@ class WaveRenderer {
   WaveRenderer(const WaveRenderer&) = delete;
   WaveRenderer& operator=(const WaveRenderer&) = delete;
   RenderResult render(const SceneView& scene, int key_bits, const RenderOptions& options, int64_t wave_size);
+  // The device memory kept for the next render's wave (0 before the first).
+  size_t kept_bytes() const;
 
  private:
   struct Kept;

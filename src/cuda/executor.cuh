@@ -110,6 +110,9 @@ class Executor {
     if (wave_.size() < bytes) wave_.allocate(bytes, "wave allocation");  // frees the old block first
     return wave_.get();
   }
+  // The bytes of the block wave_memory keeps, which serve (or, freed first, make room
+  // for) the next wave.
+  size_t wave_bytes() const { return wave_.size(); }
 
   // The most temporary storage compact (over `capacity` entries) and sort need on the
   // current device: CUB's answer, asked once for each device and capacity (a render
