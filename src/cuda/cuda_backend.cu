@@ -146,31 +146,18 @@ RenderResult render_megakernel(const Scene& scene, const DeviceScene& ds, const 
   return out;
 }
 
-// A render's device memory beyond the scene, by part: its film, the wavefront's wave,
-// and a small image's batches for the megakernels (each sample's radiance and the
-// running sums, as large as on a device of 256 SMs).
-struct RenderState {
-  size_t film = 0, wave = 0, batches = 0;
-  size_t bytes() const { return film + wave + batches; }
-};
-
-RenderState render_state(const RenderParams& rp, Kernel kernel, int64_t wave_size) {
-  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
-  RenderState state;
-  state.film = pixels * 3 * sizeof(float);
-  if (is_wavefront(kernel)) {
-    state.wave = wavefront_bytes(wave_size);
-  } else {
-    const int batch = megakernel_batch(static_cast<int64_t>(pixels), 256, rp.spp);
-    state.batches = batch > 1 ? state.film * (batch + 1) : 0;
-  }
-  return state;
-}
-
 }  // namespace
 
 size_t render_state_bytes(const RenderParams& rp, Kernel kernel, int64_t wave_size) {
-  return render_state(rp, kernel, wave_size).bytes();
+  const size_t pixels = static_cast<size_t>(rp.width) * rp.height;
+  const size_t film = pixels * 3 * sizeof(float);
+  if (is_wavefront(kernel)) {
+    return film + wavefront_bytes(wave_size);
+  }
+  // A small image's batches: each sample's radiance and the running sums, as large as
+  // on a device of 256 SMs.
+  const int batch = megakernel_batch(static_cast<int64_t>(pixels), 256, rp.spp);
+  return film + (batch > 1 ? film * (batch + 1) : 0);
 }
 
 void require_device_memory(const RenderParams& rp, size_t need, size_t free_bytes, const std::string& device) {
@@ -317,16 +304,20 @@ int64_t wave_size_on(const RenderOptions& options, const DeviceInfo& info) {
   return is_wavefront(options.kernel) ? choose_wave_size(options.wave_size, options.params, info.free_memory) : 0;
 }
 
-// Of a render's state on a kept copy, the bytes the render makes anew: its wave's
-// memory grows where it must (the old block freed first), and render_image's film
-// (`image`), which the copy keeps, is made again (freed first) where its size
-// changes, so each counts only what it needs beyond what the copy keeps of it; the
-// render's own film and the megakernels' batches are made per render.
+// Of a render's state (render_state_bytes) on a kept copy, the bytes the render makes
+// anew: its wave's memory grows where it must (the old block freed first), and
+// render_image's film (`image`), which the copy keeps, is made again (freed first)
+// where its size changes, so each counts only what it needs beyond what the copy
+// keeps of it; the rest (the render's own film, the megakernels' batches) is made
+// per render.
 size_t state_made_on(const DeviceCopy& copy, const RenderOptions& options, int64_t wave, bool image) {
-  const RenderState need = render_state(options.params, options.kernel, wave);
-  auto beyond = [](size_t part, size_t kept) { return part - std::min(part, kept); };
-  return need.batches + beyond(need.wave, copy.waves.kept_bytes()) +
-         (image ? beyond(need.film, copy.film.size() * sizeof(float)) : need.film);
+  const RenderParams& rp = options.params;
+  const size_t film = static_cast<size_t>(rp.width) * rp.height * 3 * sizeof(float);
+  const size_t wave_need = is_wavefront(options.kernel) ? wavefront_bytes(wave) : 0;
+  const size_t rest = render_state_bytes(rp, options.kernel, wave) - wave_need - (image ? film : 0);
+  auto beyond = [](size_t need, size_t kept) { return need - std::min(need, kept); };
+  return rest + beyond(wave_need, copy.waves.kept_bytes()) +
+         (image ? beyond(film, copy.film.size() * sizeof(float)) : 0);
 }
 
 // The scene on the current device (DeviceLease), and renders of any of the render's
